@@ -1,0 +1,1 @@
+"""The only package that speaks MAVLink to the vehicle (pymavlink, pyserial)."""

@@ -1,0 +1,1 @@
+"""The station: estimation, control, the fixed-rate loop, teleop, missions and the CLI."""

@@ -1,0 +1,65 @@
+"""The `quadgcs` console script: one entry point, one module per subcommand.
+
+Each module in `gcs.commands` exposes `register(subparsers)`, which adds its parser and sets
+`func` (taking the parsed namespace, returning an exit code). Expected errors derive from
+`gcs.errors.QuadgcsError` and end as one line on stderr with their exit code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from gcs.errors import QuadgcsError
+
+COMMAND_MODULES: tuple[str, ...] = (
+    "sitl",
+    "fly",
+    "teleop",
+    "mission",
+    "replay",
+    "logs",
+    "bench",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Build the top-level parser with every available subcommand registered."""
+    parser = argparse.ArgumentParser(
+        prog="quadgcs",
+        description="Ground-control station for small indoor quadrotors (MAVLink, ArduCopter).",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMAND_MODULES:
+        module_name = f"gcs.commands.{name}"
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            if exc.name != module_name:
+                raise
+            continue
+        module.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one subcommand; return its exit code (2 for usage errors)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help(sys.stderr)
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except QuadgcsError as exc:
+        print(f"quadgcs {args.command}: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print(f"quadgcs {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Subcommands of the `quadgcs` console script, one module each (see `gcs.cli`)."""

@@ -1,0 +1,1 @@
+"""Flight recording to MCAP, reading, recovery, replay, export and plots."""

@@ -1,0 +1,1 @@
+"""The bundled simulated vehicle: physics, ArduCopter-like autopilot, sensors, MAVLink endpoints."""

@@ -1,0 +1,25 @@
+"""The console script's contract: help, unknown commands, exit codes."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from gcs.cli import build_parser, main
+
+
+def test_no_command_prints_help_and_exits_2(capsys) -> None:
+    assert main([]) == 2
+    assert "usage: quadgcs" in capsys.readouterr().err
+
+
+def test_console_script_runs_as_module() -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "--help"], capture_output=True, text=True, timeout=60
+    )
+    assert proc.returncode == 0
+    assert "quadgcs" in proc.stdout
+
+
+def test_parser_builds() -> None:
+    assert build_parser().prog == "quadgcs"
