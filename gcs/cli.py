@@ -12,6 +12,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+from firmware_link.errors import LinkError
 from gcs.errors import QuadgcsError
 
 COMMAND_MODULES: tuple[str, ...] = (
@@ -56,6 +57,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except QuadgcsError as exc:
         print(f"quadgcs {args.command}: {exc}", file=sys.stderr)
         return exc.exit_code
+    except LinkError as exc:
+        print(f"quadgcs {args.command}: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"quadgcs {args.command}: interrupted", file=sys.stderr)
         return 130
