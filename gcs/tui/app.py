@@ -1,0 +1,219 @@
+"""The teleop TUI: the thesis's LabVIEW front panel, made for a terminal.
+
+The app never touches the link or the 25 ms loop. It redraws from `backend.view()` on a timer
+(8 Hz: `set_interval` drops missed ticks, so a slow terminal only lowers the redraw rate) and
+hands the pilot's intents to `backend.send()`, which queues them for the loop thread.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from rich.text import Text
+from textual.app import App, ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal
+from textual.widgets import Footer, RichLog
+
+from gcs.tui import intents
+from gcs.tui.backend import TeleopBackend
+from gcs.tui.help import HelpScreen, describe
+from gcs.tui.sticks import Sticks
+from gcs.tui.view import TeleopView
+from gcs.tui.widgets import AccelPlot, AltitudePanel, HeightPlot, LinkPanel, VehiclePanel
+
+REDRAW_HZ = 8.0
+PLOT_HZ = 4.0
+STICK_HZ = 20.0
+SETPOINT_STEP_M = 0.1
+
+
+LIVE_BINDINGS = [
+    Binding("a", "arm", "Arm"),
+    Binding("d", "disarm", "Disarm"),
+    Binding("space", "kill", "KILL", priority=True),
+    Binding("1", "mode('STABILIZE')", "Stabilize"),
+    Binding("2", "mode('ALT_HOLD')", "AltHold (onboard)"),
+    Binding("l", "mode('LAND')", "Land"),
+    Binding("h", "toggle_hold", "PC alt hold"),
+    Binding("w", "throttle(1)", "Throttle up", show=False),
+    Binding("s", "throttle(-1)", "Throttle down", show=False),
+    Binding("pageup,plus", "setpoint(1)", "Setpoint up", show=False),
+    Binding("pagedown,minus", "setpoint(-1)", "Setpoint down", show=False),
+    Binding("up", "stick('pitch', 1)", "Pitch forward", show=False),
+    Binding("down", "stick('pitch', -1)", "Pitch back", show=False),
+    Binding("left", "stick('roll', -1)", "Roll left", show=False),
+    Binding("right", "stick('roll', 1)", "Roll right", show=False),
+    Binding("q", "stick('yaw', -1)", "Yaw left", show=False),
+    Binding("e", "stick('yaw', 1)", "Yaw right", show=False),
+    ]
+REPLAY_BINDINGS = [
+    Binding("p", "pause", "Play/pause"),
+    Binding("right", "seek(10)", "+10 s"),
+    Binding("left", "seek(-10)", "-10 s"),
+    Binding("plus", "speed(2)", "Faster"),
+    Binding("minus", "speed(0.5)", "Slower"),
+    ]
+COMMON_BINDINGS = [
+    Binding("question_mark", "help", "Help"),
+    Binding("ctrl+c,ctrl+q", "quit", "Quit", priority=True),
+    ]
+
+
+class TeleopApp(App[None]):
+    """Fly and watch one vehicle from a terminal (or watch a recorded flight)."""
+
+    CSS_PATH = "app.tcss"
+    TITLE = "quadgcs"
+    BINDINGS = COMMON_BINDINGS
+
+    def __init__(
+        self,
+        backend: TeleopBackend,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        super().__init__()
+        self.backend = backend
+        self._clock = clock
+        self.sticks = Sticks()
+        self._messages_shown = 0
+        self._hold_on = False
+        self.frozen = False  # tests freeze redraws before asserting on the screen
+        self._help_text = describe([*type(self).BINDINGS, *COMMON_BINDINGS])
+
+    def compose(self) -> ComposeResult:
+        """Three panels, two graph indicators, a message log and the key hints."""
+        with Horizontal(id="panels"):
+            yield LinkPanel(id="link", classes="panel")
+            yield VehiclePanel(id="vehicle", classes="panel")
+            yield AltitudePanel(id="altitude", classes="panel")
+        with Horizontal(id="plots"):
+            yield HeightPlot(id="height-plot")
+            yield AccelPlot(id="accel-plot")
+        yield RichLog(id="messages", max_lines=500, wrap=False, markup=False)
+        yield Footer()
+
+    def on_mount(self) -> None:
+        """Start the redraw and stick timers."""
+        self.query_one("#link").border_title = "link"
+        self.query_one("#vehicle").border_title = "vehicle"
+        self.query_one("#altitude").border_title = "altitude"
+        self.query_one("#messages").border_title = "messages"
+        self.set_interval(1.0 / REDRAW_HZ, self.redraw)
+        self.set_interval(1.0 / PLOT_HZ, self.redraw_plots)
+        if self.backend.live:
+            self.set_interval(1.0 / STICK_HZ, self.send_sticks)
+        self.redraw()
+
+    def on_unmount(self) -> None:
+        """Let the backend release overrides and stop its thread."""
+        self.backend.close()
+
+    # --- display -------------------------------------------------------------------------
+
+    def redraw(self) -> None:
+        """Copy the latest view into the panels and append new messages."""
+        if self.frozen:
+            return
+        view = self.backend.view()
+        for panel in self.query(".panel").results():
+            panel.view = view  # type: ignore[attr-defined]
+        self._hold_on = view.altitude.hold_on
+        log = self.query_one("#messages", RichLog)
+        for t_s, text in view.messages[self._messages_shown :]:
+            log.write(Text(f"{t_s:8.1f}  {text}"))
+        self._messages_shown = len(view.messages)
+
+    def redraw_plots(self) -> None:
+        """Redraw the two graphs (slower than the panels: plotext costs milliseconds)."""
+        if self.frozen:
+            return
+        view: TeleopView = self.backend.view()
+        self.query_one(HeightPlot).show(view)
+        self.query_one(AccelPlot).show(view)
+
+    def send_sticks(self) -> None:
+        """Hand the current stick positions to the loop (it repeats them every 25 ms)."""
+        now = self._clock()
+        self.backend.send(
+            intents.Sticks(
+                roll=self.sticks.value("roll", now),
+                pitch=self.sticks.value("pitch", now),
+                yaw=self.sticks.value("yaw", now),
+                throttle_us=self.sticks.throttle_us,
+            )
+        )
+
+    # --- actions -------------------------------------------------------------------------
+
+    def action_arm(self) -> None:
+        """Arm (the vehicle answers; the result shows in messages)."""
+        self.backend.send(intents.Arm())
+
+    def action_disarm(self) -> None:
+        """Disarm."""
+        self.backend.send(intents.Disarm())
+
+    def action_kill(self) -> None:
+        """Emergency kill: throttle cut and disarm, no confirmation."""
+        self.sticks.cut()
+        self.backend.send(intents.Kill())
+
+    def action_mode(self, mode: str) -> None:
+        """Change flight mode."""
+        self.backend.send(intents.SetMode(mode))
+
+    def action_toggle_hold(self) -> None:
+        """Engage or release altitude hold on the PC."""
+        self._hold_on = not self._hold_on
+        self.backend.send(intents.AltHold(self._hold_on))
+
+    def action_throttle(self, direction: int) -> None:
+        """Throttle one step up or down."""
+        self.sticks.nudge_throttle(direction)
+        self.send_sticks()
+
+    def action_setpoint(self, direction: int) -> None:
+        """Altitude-hold setpoint one step up or down."""
+        self.backend.send(intents.SetpointStep(direction * SETPOINT_STEP_M))
+
+    def action_stick(self, axis: str, direction: int) -> None:
+        """Deflect a self-centring stick."""
+        self.sticks.push(axis, direction, self._clock())
+        self.send_sticks()
+
+    def action_pause(self) -> None:
+        """Replay: play/pause."""
+        self.backend.send(intents.TogglePause())
+
+    def action_seek(self, delta_s: float) -> None:
+        """Replay: jump."""
+        self.backend.send(intents.Seek(delta_s))
+
+    def action_speed(self, factor: float) -> None:
+        """Replay: faster or slower."""
+        self.backend.send(intents.ScaleSpeed(factor))
+
+    def action_help(self) -> None:
+        """Show every binding."""
+        self.push_screen(HelpScreen(self._help_text))
+
+
+class LiveTeleopApp(TeleopApp):
+    """Teleop of a live vehicle."""
+
+    BINDINGS = LIVE_BINDINGS
+
+
+class ReplayApp(TeleopApp):
+    """The same screens on a recorded flight: play/pause, speed, seek."""
+
+    BINDINGS = REPLAY_BINDINGS
+
+
+def make_app(backend: TeleopBackend, **kwargs: Callable[[], float]) -> TeleopApp:
+    """The live or replay app, as the backend is."""
+    cls = LiveTeleopApp if backend.live else ReplayApp
+    return cls(backend, **kwargs)

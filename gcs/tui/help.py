@@ -1,0 +1,42 @@
+"""The help screen: every key binding, generated from the app's own bindings."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Vertical
+from textual.screen import ModalScreen
+from textual.widgets import Static
+
+
+def describe(bindings: list[BindingType]) -> str:
+    """One line per binding: keys, then what they do."""
+    rows = []
+    for b in bindings:
+        if isinstance(b, Binding):
+            keys, desc = b.key, b.description
+        else:
+            keys, desc = b[0], b[2] if len(b) > 2 else b[1]
+        rows.append(f"  {keys.replace(',', ' / '):<24} {desc}")
+    return "\n".join(rows)
+
+
+class HelpScreen(ModalScreen[None]):
+    """Lists every binding; any key closes it."""
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        ("escape,question_mark,q", "dismiss", "Close help")
+    ]
+
+    def __init__(self, text: str) -> None:
+        super().__init__()
+        self._text = text
+
+    def compose(self) -> ComposeResult:
+        """A single bordered box of text."""
+        with Vertical(id="help-box"):
+            yield Static("Key bindings", id="help-title")
+            yield Static(self._text, id="help-body")
+            yield Static("Press Esc or ? to close.", id="help-foot")
