@@ -1,0 +1,1 @@
+"""Missions: files, the executor that connects planners to vehicles, and their metrics."""

@@ -1,0 +1,229 @@
+"""Mission files: TOML under `missions/`, loaded into a typed, validated `MissionSpec`.
+
+A bad file ends in one line naming the file, the field, its line when it can be found, what
+was wrong and what is expected, e.g.
+`missions/x.toml:12: planner.kind: expected one of epbha, flocking, radiation, got "epbh"`.
+
+Positions in mission files are written as a user thinks of a room: `[x, y, alt]` with x north,
+y east and altitude positive up (metres); they are turned into local NED here, once.
+"""
+
+from __future__ import annotations
+
+import enum
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gcs.errors import UsageError
+
+Vec3 = tuple[float, float, float]
+
+
+class PlannerKind(enum.Enum):
+    """Which of the thesis's planners a mission flies."""
+
+    EPBHA = "epbha"
+    FLOCKING = "flocking"
+    RADIATION = "radiation"
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleSpec:
+    """One vehicle of the mission: its system id and where it starts (NED, on the floor)."""
+
+    sysid: int
+    start_n: Vec3 | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class MissionSpec:
+    """A validated mission file."""
+
+    path: Path
+    name: str
+    world_path: Path | None
+    vehicles: tuple[VehicleSpec, ...]
+    takeoff_alt_m: float
+    planner: PlannerKind
+    planner_params: dict[str, Any]
+    goals_n: tuple[Vec3, ...]
+    goal_tolerance_m: float
+    land: bool
+    max_duration_s: float
+    profile: str
+    text: str = field(repr=False, default="")
+
+    @property
+    def goal_n(self) -> Vec3 | None:
+        """The first (common) goal, if any."""
+        return self.goals_n[0] if self.goals_n else None
+
+
+class _Reader:
+    """Walks a parsed TOML table and reports errors with the field's dotted name and line."""
+
+    def __init__(self, path: Path, text: str) -> None:
+        self.path = path
+        self.lines = text.splitlines()
+
+    def fail(self, dotted: str, problem: str) -> UsageError:
+        line = self._line_of(dotted)
+        where = f"{self.path}:{line}" if line else str(self.path)
+        return UsageError(f"{where}: {dotted}: {problem}")
+
+    def _line_of(self, dotted: str) -> int | None:
+        parts = re.sub(r"\[\d+\]", "", dotted).split(".")
+        key = parts[-1]
+        table = ".".join(parts[:-1])
+        in_table = table == ""
+        for number, raw in enumerate(self.lines, start=1):
+            line = raw.strip()
+            header = re.match(r"^\[\[?([^\]]+)\]\]?$", line)
+            if header:
+                name = header.group(1).strip()
+                if name == ".".join(parts):
+                    return number
+                in_table = name == table
+                continue
+            if in_table and re.match(rf"^{re.escape(key)}\s*=", line):
+                return number
+        return None
+
+    def number(self, table: dict[str, Any], key: str, dotted: str, default: float | None = None,
+               *, positive: bool = False) -> float:
+        value = table.get(key, default)
+        if value is None:
+            raise self.fail(dotted, "missing; expected a number")
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(dotted, f"expected a number, got {value!r}")
+        if positive and value <= 0:
+            raise self.fail(dotted, f"expected a positive number, got {value!r}")
+        return float(value)
+
+    def vec3(self, value: Any, dotted: str) -> Vec3:
+        if (
+            not isinstance(value, list)
+            or len(value) != 3
+            or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+        ):
+            raise self.fail(dotted, f"expected [x, y, alt] (3 numbers, metres), got {value!r}")
+        x, y, alt = (float(v) for v in value)
+        return (x, y, -alt)
+
+
+PLANNER_KEYS = {"kind"}
+
+
+def load_mission(path: str | Path) -> MissionSpec:
+    """Read and validate a mission file; raise UsageError with one line on any problem."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UsageError(f"{path}: no such mission file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UsageError(f"{path}: cannot read mission file ({exc})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise UsageError(f"{path}: not valid TOML ({exc})") from None
+    r = _Reader(path, text)
+
+    name = data.get("name", path.stem)
+    if not isinstance(name, str):
+        raise r.fail("name", f"expected a string, got {name!r}")
+
+    world_path: Path | None = None
+    if "world" in data:
+        world = data["world"]
+        if not isinstance(world, str):
+            raise r.fail("world", f"expected a path to a world file, got {world!r}")
+        world_path = (path.parent / world).resolve()
+        if not world_path.is_file():
+            raise r.fail("world", f"world file {world_path} does not exist")
+
+    vehicles = _vehicles(r, data)
+
+    flight = data.get("flight", {})
+    if not isinstance(flight, dict):
+        raise r.fail("flight", "expected a table")
+    takeoff_alt_m = r.number(flight, "takeoff_alt_m", "flight.takeoff_alt_m", 1.0, positive=True)
+    land = flight.get("land", True)
+    if not isinstance(land, bool):
+        raise r.fail("flight.land", f"expected true or false, got {land!r}")
+    max_duration_s = r.number(flight, "max_duration_s", "flight.max_duration_s", 600.0,
+                              positive=True)
+    profile = flight.get("profile", "apm25")
+    if profile not in ("apm25", "copter4"):
+        raise r.fail("flight.profile", f"expected apm25 or copter4, got {profile!r}")
+
+    planner_table = data.get("planner")
+    if not isinstance(planner_table, dict):
+        raise r.fail("planner", "missing; expected a [planner] table with kind = ...")
+    kind_name = planner_table.get("kind")
+    kinds = ", ".join(k.value for k in PlannerKind)
+    try:
+        planner = PlannerKind(kind_name)
+    except ValueError:
+        raise r.fail("planner.kind", f"expected one of {kinds}, got {kind_name!r}") from None
+    params = {k: v for k, v in planner_table.items() if k not in PLANNER_KEYS}
+
+    goals_n, tolerance_m = _goals(r, data, planner)
+
+    return MissionSpec(
+        path=path,
+        name=name,
+        world_path=world_path,
+        vehicles=vehicles,
+        takeoff_alt_m=takeoff_alt_m,
+        planner=planner,
+        planner_params=params,
+        goals_n=goals_n,
+        goal_tolerance_m=tolerance_m,
+        land=land,
+        max_duration_s=max_duration_s,
+        profile=profile,
+        text=text,
+    )
+
+
+def _vehicles(r: _Reader, data: dict[str, Any]) -> tuple[VehicleSpec, ...]:
+    raw = data.get("vehicles", [{"sysid": 1}])
+    if not isinstance(raw, list) or not raw:
+        raise r.fail("vehicles", "expected one or more [[vehicles]] tables")
+    out: list[VehicleSpec] = []
+    seen: set[int] = set()
+    for i, v in enumerate(raw):
+        dotted = f"vehicles[{i}]"
+        if not isinstance(v, dict):
+            raise r.fail(dotted, "expected a table")
+        sysid = v.get("sysid", i + 1)
+        if isinstance(sysid, bool) or not isinstance(sysid, int) or not 1 <= sysid <= 250:
+            raise r.fail(f"{dotted}.sysid", f"expected a system id 1..250, got {sysid!r}")
+        if sysid in seen:
+            raise r.fail(f"{dotted}.sysid", f"system id {sysid} used twice")
+        seen.add(sysid)
+        start = r.vec3(v["start"], f"{dotted}.start") if "start" in v else None
+        out.append(VehicleSpec(sysid=sysid, start_n=start))
+    return tuple(out)
+
+
+def _goals(r: _Reader, data: dict[str, Any], planner: PlannerKind) -> tuple[tuple[Vec3, ...],
+                                                                             float]:
+    goal = data.get("goal", {})
+    if not isinstance(goal, dict):
+        raise r.fail("goal", "expected a [goal] table")
+    tolerance_m = r.number(goal, "tolerance_m", "goal.tolerance_m", 0.25, positive=True)
+    goals: list[Vec3] = []
+    if "position" in goal:
+        goals.append(r.vec3(goal["position"], "goal.position"))
+    extra = goal.get("individual", [])
+    if not isinstance(extra, list):
+        raise r.fail("goal.individual", "expected a list of [x, y, alt] positions")
+    goals.extend(r.vec3(g, f"goal.individual[{i}]") for i, g in enumerate(extra))
+    if planner in (PlannerKind.EPBHA, PlannerKind.FLOCKING) and not goals:
+        raise r.fail("goal.position", f"missing; a {planner.value} mission needs a goal")
+    return tuple(goals), tolerance_m
