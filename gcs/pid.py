@@ -1,0 +1,147 @@
+"""PID controller per thesis eqs. 6.2–6.4, in the style of ArduPilot's AC_PID.
+
+Departures from the text, all ones the thesis itself argues for in section 6.3:
+- The derivative acts on the measurement, not the error, so a setpoint step gives no
+  derivative kick. When the caller has a better rate (the estimator's velocity) it may pass it
+  as `measurement_rate`; otherwise the measurement is differenced.
+- Eq. 6.4's real derivator puts a pole at k·K_P/K_D; here the pole is a first-order low-pass
+  with an explicit cut-off `d_filter_hz`, which is the same filter with a tunable corner.
+- The integrator is clamped to ±`i_max` and frozen while the output is saturated in the
+  direction the error would push it (conditional integration), against wind-up.
+- `engage()` initialises the integrator so the first output equals the actuator's present
+  value (bumpless transfer), and an optional setpoint slew limit smooths setpoint steps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, slots=True)
+class PidGains:
+    """Tunable parameters (output units per error unit); kept apart from runtime state."""
+
+    kp: float
+    ki: float
+    kd: float
+    i_max: float  # |I term| limit, output units
+    out_min: float
+    out_max: float
+    d_filter_hz: float = 10.0  # first-order low-pass on the derivative term
+    setpoint_slew_per_s: float = math.inf  # max rate of change of the shaped setpoint
+
+    def __post_init__(self) -> None:
+        if min(self.kp, self.ki, self.kd, self.i_max) < 0.0:
+            raise ValueError(f"PID gains and i_max must be >= 0: {self}")
+        if self.out_min >= self.out_max:
+            raise ValueError(f"out_min must be < out_max: {self.out_min} >= {self.out_max}")
+        if self.d_filter_hz <= 0.0 or self.setpoint_slew_per_s <= 0.0:
+            raise ValueError("d_filter_hz and setpoint_slew_per_s must be > 0")
+
+
+@dataclass(frozen=True, slots=True)
+class PidTerms:
+    """One step's diagnostic record: what the controller saw and what each term contributed."""
+
+    target: float  # the setpoint given
+    shaped_target: float  # after the slew limit
+    measurement: float
+    error: float  # shaped_target - measurement
+    p: float
+    i: float
+    d: float
+    out: float  # saturated output
+    saturated: bool
+
+
+class Pid:
+    """Discrete PID with derivative on measurement, anti-wind-up, saturation, bumpless engage."""
+
+    def __init__(self, gains: PidGains) -> None:
+        self.gains = gains
+        self._i = 0.0
+        self._d = 0.0
+        self._prev_measurement: float | None = None
+        self._shaped: float | None = None
+        self._last_out = 0.0
+
+    @property
+    def integrator(self) -> float:
+        """The present I term (output units)."""
+        return self._i
+
+    def reset_I(self) -> None:  # AC_PID's name
+        """Zero the integrator."""
+        self._i = 0.0
+
+    def reset_filter(self) -> None:
+        """Forget the derivative history (the next step computes no derivative)."""
+        self._d = 0.0
+        self._prev_measurement = None
+
+    def reset(self) -> None:
+        """Forget everything: integrator, derivative history and the shaped setpoint."""
+        self.reset_I()
+        self.reset_filter()
+        self._shaped = None
+
+    def engage(self, target: float, measurement: float, output: float) -> None:
+        """Start so the first output is `output` (bumpless); the shaped setpoint starts at the
+        measurement and slews towards `target`."""
+        self.reset_filter()
+        self._shaped = measurement
+        self._prev_measurement = measurement
+        g = self.gains
+        # the shaped setpoint starts at the measurement, so P and D are zero on the first step
+        self._i = min(max(output, -g.i_max), g.i_max)
+        self._last_out = output
+
+    def update(
+        self,
+        target: float,
+        measurement: float,
+        dt_s: float,
+        measurement_rate: float | None = None,
+    ) -> PidTerms:
+        """One step: returns the terms and the saturated output."""
+        if dt_s <= 0.0:
+            raise ValueError(f"dt_s must be > 0, got {dt_s}")
+        g = self.gains
+        if self._shaped is None:
+            self._shaped = target
+        step = g.setpoint_slew_per_s * dt_s
+        self._shaped += min(max(target - self._shaped, -step), step)
+        error = self._shaped - measurement
+
+        if measurement_rate is not None:
+            d_raw = -g.kd * measurement_rate
+        elif self._prev_measurement is not None:
+            d_raw = -g.kd * (measurement - self._prev_measurement) / dt_s
+        else:
+            d_raw = 0.0
+        self._prev_measurement = measurement
+        rc = 1.0 / (2.0 * math.pi * g.d_filter_hz)
+        self._d += (dt_s / (dt_s + rc)) * (d_raw - self._d)
+
+        p = g.kp * error
+        i_next = self._i + g.ki * error * dt_s
+        unsat = p + i_next + self._d
+        # conditional integration: don't integrate further into a saturated output
+        if (unsat > g.out_max and error > 0.0) or (unsat < g.out_min and error < 0.0):
+            i_next = self._i
+        self._i = min(max(i_next, -g.i_max), g.i_max)
+        total = p + self._i + self._d
+        out = min(max(total, g.out_min), g.out_max)
+        self._last_out = out
+        return PidTerms(
+            target=target,
+            shaped_target=self._shaped,
+            measurement=measurement,
+            error=error,
+            p=p,
+            i=self._i,
+            d=self._d,
+            out=out,
+            saturated=out != total,
+        )

@@ -1,0 +1,106 @@
+"""PID behaviour: no derivative kick, anti-wind-up recovery, saturation, bumpless engage."""
+
+from __future__ import annotations
+
+import pytest
+
+from gcs.pid import Pid, PidGains
+
+GAINS = PidGains(kp=2.0, ki=1.0, kd=0.5, i_max=3.0, out_min=-5.0, out_max=5.0, d_filter_hz=5.0)
+
+
+def test_setpoint_step_gives_no_derivative_kick() -> None:
+    pid = Pid(GAINS)
+    for _ in range(10):
+        pid.update(0.0, 0.0, 0.025)
+    terms = pid.update(1.0, 0.0, 0.025)
+    assert terms.d == 0.0
+    assert terms.p == pytest.approx(2.0)
+
+
+def test_derivative_opposes_measurement_motion_and_is_filtered() -> None:
+    pid = Pid(GAINS)
+    pid.update(0.0, 0.0, 0.025)
+    first = pid.update(0.0, 0.01, 0.025)  # rising at 0.4/s -> raw D = -0.2
+    assert -0.2 < first.d < 0.0
+    for k in range(2, 60):
+        last = pid.update(0.0, 0.01 * k, 0.025)
+    assert last.d == pytest.approx(-0.2, rel=1e-3)
+
+
+def test_measurement_rate_input_replaces_differencing() -> None:
+    pid = Pid(PidGains(kp=0.0, ki=0.0, kd=1.0, i_max=1.0, out_min=-9, out_max=9, d_filter_hz=1e6))
+    terms = pid.update(0.0, 5.0, 0.025, measurement_rate=2.0)
+    assert terms.d == pytest.approx(-2.0, rel=1e-4)
+
+
+def test_output_saturates_and_reports_it() -> None:
+    pid = Pid(GAINS)
+    terms = pid.update(10.0, 0.0, 0.025)
+    assert terms.out == 5.0
+    assert terms.saturated
+
+
+def test_integrator_clamped_and_recovers_quickly_after_saturation() -> None:
+    pid = Pid(GAINS)
+    for _ in range(2000):  # 50 s of large error, output pinned at out_max
+        terms = pid.update(10.0, 0.0, 0.025)
+    assert terms.i <= GAINS.i_max
+    # conditional integration: the integrator stopped growing once the output saturated
+    assert terms.i < 0.2
+    # error changes sign: output leaves saturation at once, no long wind-down
+    recovered = pid.update(-0.5, 0.0, 0.025)
+    assert recovered.out < 0.0
+
+
+def test_integrator_limit_when_not_saturated() -> None:
+    gains = PidGains(kp=0.0, ki=10.0, kd=0.0, i_max=1.0, out_min=-5.0, out_max=5.0)
+    pid = Pid(gains)
+    for _ in range(200):
+        terms = pid.update(1.0, 0.0, 0.025)
+    assert terms.i == pytest.approx(1.0)
+    assert terms.out == pytest.approx(1.0)
+
+
+def test_integral_removes_steady_state_error_against_constant_disturbance() -> None:
+    pid = Pid(PidGains(kp=4.0, ki=2.0, kd=2.0, i_max=5.0, out_min=-10, out_max=10))
+    h, v, dt = 0.0, 0.0, 0.01
+    for _ in range(3000):  # double integrator with a constant -1 m/s² disturbance
+        a = pid.update(1.0, h, dt, measurement_rate=v).out - 1.0
+        v += a * dt
+        h += v * dt
+    assert h == pytest.approx(1.0, abs=1e-3)
+    assert pid.integrator == pytest.approx(1.0, abs=1e-2)
+
+
+def test_bumpless_engage_first_output_equals_present_actuator() -> None:
+    pid = Pid(GAINS)
+    pid.engage(target=2.0, measurement=1.0, output=1.7)
+    terms = pid.update(2.0, 1.0, 0.025)
+    # setpoint slew is unlimited by default, so P acts at once but I starts at the actuator
+    assert terms.i == pytest.approx(1.7 + GAINS.ki * 1.0 * 0.025)
+    slewed = Pid(PidGains(**{**_asdict(GAINS), "setpoint_slew_per_s": 0.4}))
+    slewed.engage(target=2.0, measurement=1.0, output=1.7)
+    first = slewed.update(2.0, 1.0, 0.025)
+    assert first.out == pytest.approx(1.7 + 2.0 * 0.01, abs=1e-3)
+    assert first.shaped_target == pytest.approx(1.01)
+
+
+def test_setpoint_slew_limits_shaped_target_rate() -> None:
+    pid = Pid(PidGains(kp=1, ki=0, kd=0, i_max=0, out_min=-9, out_max=9, setpoint_slew_per_s=1.0))
+    pid.update(0.0, 0.0, 0.1)
+    shaped = [pid.update(1.0, 0.0, 0.1).shaped_target for _ in range(12)]
+    assert shaped[0] == pytest.approx(0.1)
+    assert shaped[4] == pytest.approx(0.5)
+    assert shaped[-1] == pytest.approx(1.0)
+
+
+def test_bad_gains_rejected() -> None:
+    with pytest.raises(ValueError, match="out_min"):
+        PidGains(kp=1, ki=0, kd=0, i_max=1, out_min=1, out_max=0)
+    with pytest.raises(ValueError, match="dt_s"):
+        Pid(GAINS).update(0, 0, 0.0)
+
+
+def _asdict(g: PidGains) -> dict:
+    return {f: getattr(g, f) for f in g.__slots__}
