@@ -1,1 +1,34 @@
 """Flight recording to MCAP, reading, recovery, replay, export and plots."""
+
+from logs.errors import RecordingError
+from logs.foxglove import (
+    FoxgloveMessage,
+    LogLevel,
+    SceneBox,
+    foxglove_grid,
+    foxglove_log,
+    foxglove_pose,
+    foxglove_scene_from_boxes,
+    foxglove_transform,
+    foxglove_vehicle_transform,
+)
+from logs.reader import Recording, open_recording
+from logs.recorder import Direction, Recorder, RecorderStats
+
+__all__ = [
+    "Direction",
+    "FoxgloveMessage",
+    "LogLevel",
+    "Recorder",
+    "RecorderStats",
+    "Recording",
+    "RecordingError",
+    "SceneBox",
+    "foxglove_grid",
+    "foxglove_log",
+    "foxglove_pose",
+    "foxglove_scene_from_boxes",
+    "foxglove_transform",
+    "foxglove_vehicle_transform",
+    "open_recording",
+]

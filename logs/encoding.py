@@ -1,0 +1,184 @@
+"""Payloads to JSON: dataclass or dict → JSON-ready dict, and a JSON Schema generated from it.
+
+Convention (chosen for Foxglove's Plot panel, which plots any numeric path): records stay flat;
+a fixed 3-float tuple (a `Vec3` such as `acc_b`, `pos_n`) becomes an `{"x","y","z"}` object and a
+fixed 4-float tuple (a quaternion, w-x-y-z order) becomes `{"w","x","y","z"}`, so a plot path
+reads `/vehicle/imu.acc_b.z`. Other tuples and lists stay arrays (`channels_us[2]`). Enums
+become their value (an IntEnum its integer). Non-finite floats become null, since JSON has none.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import json
+import math
+import types
+import typing
+from collections.abc import Mapping
+from typing import Any
+
+VEC3_KEYS = ("x", "y", "z")
+QUAT_KEYS = ("w", "x", "y", "z")
+
+_HINTS_CACHE: dict[type, dict[str, Any]] = {}
+
+
+def _hints(cls: type) -> dict[str, Any]:
+    """Resolved field type hints of a dataclass, cached per class."""
+    hints = _HINTS_CACHE.get(cls)
+    if hints is None:
+        try:
+            hints = typing.get_type_hints(cls)
+        except (NameError, TypeError):
+            hints = {}
+        _HINTS_CACHE[cls] = hints
+    return hints
+
+
+def _fixed_float_tuple_len(hint: Any) -> int:
+    """3 or 4 for `tuple[float, float, float(, float)]`, else 0."""
+    if typing.get_origin(hint) is not tuple:
+        return 0
+    args = typing.get_args(hint)
+    if len(args) in (3, 4) and all(a is float for a in args):
+        return len(args)
+    return 0
+
+
+def to_jsonable(value: Any, hint: Any = None) -> Any:
+    """Convert a payload value to plain JSON types following the module's conventions."""
+    if isinstance(value, enum.Enum):
+        return value.value
+    if isinstance(value, bool | int | str) or value is None:
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        hints = _hints(type(value))
+        return {
+            f.name: to_jsonable(getattr(value, f.name), hints.get(f.name))
+            for f in dataclasses.fields(value)
+        }
+    if isinstance(value, Mapping):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, tuple | list):
+        n = _fixed_float_tuple_len(hint)
+        if n and len(value) == n:
+            keys = VEC3_KEYS if n == 3 else QUAT_KEYS
+            return {k: to_jsonable(float(v)) for k, v in zip(keys, value, strict=True)}
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, bytes | bytearray):
+        return list(value)
+    if hasattr(value, "tolist"):  # numpy scalars and arrays
+        return to_jsonable(value.tolist())
+    return str(value)
+
+
+def encode_json(message: Mapping[str, Any]) -> bytes:
+    """Compact UTF-8 JSON; a message that still holds a non-finite float has it nulled."""
+    try:
+        return json.dumps(message, separators=(",", ":"), allow_nan=False).encode()
+    except ValueError:
+        return json.dumps(_null_non_finite(message), separators=(",", ":")).encode()
+
+
+def _null_non_finite(value: Any) -> Any:
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, Mapping):
+        return {k: _null_non_finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_null_non_finite(v) for v in value]
+    return value
+
+
+def _schema_for_hint(hint: Any) -> dict[str, Any]:
+    """JSON Schema of one field from its Python type hint."""
+    origin = typing.get_origin(hint)
+    if hint is bool:
+        return {"type": "boolean"}
+    if isinstance(hint, type) and issubclass(hint, enum.Enum):
+        values = [m.value for m in hint]
+        kind = "integer" if all(isinstance(v, int) for v in values) else "string"
+        return {"type": kind, "enum": values, "description": hint.__name__}
+    if hint is int:
+        return {"type": "integer"}
+    if hint is float:
+        return {"type": ["number", "null"]}
+    if hint is str:
+        return {"type": "string"}
+    if hint is bytes:
+        return {"type": "array", "items": {"type": "integer"}}
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):
+        return schema_for_dataclass(hint)
+    if origin is tuple or origin is list:
+        n = _fixed_float_tuple_len(hint)
+        if n:
+            keys = VEC3_KEYS if n == 3 else QUAT_KEYS
+            return {
+                "type": "object",
+                "properties": {k: {"type": ["number", "null"]} for k in keys},
+            }
+        args = [a for a in typing.get_args(hint) if a is not Ellipsis]
+        item = _schema_for_hint(args[0]) if len(set(args)) == 1 else {}
+        return {"type": "array", "items": item}
+    if origin is dict or hint is dict:
+        return {"type": "object"}
+    if origin in (typing.Union, types.UnionType):
+        args = typing.get_args(hint)
+        non_none = [a for a in args if a is not type(None)]
+        if len(non_none) == 1:
+            inner = dict(_schema_for_hint(non_none[0]))
+            kind = inner.get("type")
+            if isinstance(kind, str):
+                inner["type"] = [kind, "null"]
+            return inner
+    return {}
+
+
+def schema_for_dataclass(cls: type) -> dict[str, Any]:
+    """JSON Schema (object) from a dataclass's field types."""
+    hints = _hints(cls)
+    props = {f.name: _schema_for_hint(hints.get(f.name)) for f in dataclasses.fields(cls)}
+    schema: dict[str, Any] = {"type": "object", "title": cls.__name__, "properties": props}
+    if cls.__doc__:
+        schema["description"] = cls.__doc__.strip().splitlines()[0]
+    return schema
+
+
+def schema_for_value(value: Any) -> dict[str, Any]:
+    """JSON Schema inferred from an already JSON-ready value (for dict payloads)."""
+    if isinstance(value, bool):
+        return {"type": "boolean"}
+    if isinstance(value, int):
+        return {"type": "integer"}
+    if isinstance(value, float) or value is None:
+        return {"type": ["number", "null"]}
+    if isinstance(value, str):
+        return {"type": "string"}
+    if isinstance(value, Mapping):
+        return {
+            "type": "object",
+            "properties": {str(k): schema_for_value(v) for k, v in value.items()},
+        }
+    if isinstance(value, list):
+        return {"type": "array", "items": schema_for_value(value[0]) if value else {}}
+    return {}
+
+
+def schema_for_payload(payload: Any, jsonable: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
+    """(schema name, JSON Schema) for a topic's first payload."""
+    if dataclasses.is_dataclass(payload) and not isinstance(payload, type):
+        cls = type(payload)
+        return f"{cls.__module__}.{cls.__qualname__}", schema_for_dataclass(cls)
+    schema = schema_for_value(dict(jsonable))
+    return "", schema
+
+
+def vector(value: Any) -> tuple[float, ...]:
+    """Turn a recorded vector back into a tuple: an x/y/z (or w/x/y/z) object or a list."""
+    if isinstance(value, Mapping):
+        keys = QUAT_KEYS if "w" in value else VEC3_KEYS
+        return tuple(float(value[k]) if value[k] is not None else math.nan for k in keys)
+    return tuple(float(v) for v in value)

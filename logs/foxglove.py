@@ -1,0 +1,385 @@
+"""Foxglove's well-known JSON schemas and helpers that build their messages.
+
+Schema names are exact (`foxglove.Log`, `foxglove.PoseInFrame`, `foxglove.FrameTransform`,
+`foxglove.SceneUpdate`, `foxglove.Grid`) so Foxglove's 3D, Log and Map panels recognise them.
+Times are `{"sec", "nsec"}`; the helpers leave `timestamp` out and the recorder fills it from the
+message's log time, so a caller never needs the recording's UTC anchor. Enums are integers.
+
+Frames: poses, scenes and grids are in the station's local NED frame, `frame_id = "ned"`. Foxglove
+draws z up, so the recorder also writes one `foxglove.FrameTransform` from a z-up display frame
+`"world"` (east-north-up) to `"ned"`; pick "world" as the display frame and NED data stands the
+right way up.
+"""
+
+from __future__ import annotations
+
+import base64
+import enum
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+NED_FRAME = "ned"
+DISPLAY_FRAME = "world"
+
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+
+
+class LogLevel(enum.IntEnum):
+    """foxglove.Log levels."""
+
+    UNKNOWN = 0
+    DEBUG = 1
+    INFO = 2
+    WARNING = 3
+    ERROR = 4
+    FATAL = 5
+
+
+class NumericType(enum.IntEnum):
+    """foxglove.PackedElementField numeric types (the ones used here)."""
+
+    UINT8 = 1
+    FLOAT32 = 7
+    FLOAT64 = 8
+
+
+@dataclass(frozen=True, slots=True)
+class FoxgloveMessage:
+    """A message of a well-known Foxglove schema, ready for `Recorder.put`."""
+
+    schema_name: str
+    data: Mapping[str, Any]
+
+
+@dataclass(frozen=True, slots=True)
+class SceneBox:
+    """An axis-aligned box in local NED: min and max corners (m), colour RGBA 0..1."""
+
+    min_n: Vec3
+    max_n: Vec3
+    color_rgba: tuple[float, float, float, float] = (0.55, 0.55, 0.6, 0.8)
+    id: str = ""
+    metadata: Mapping[str, str] = field(default_factory=dict)
+
+
+_TIME = {
+    "type": "object",
+    "title": "time",
+    "properties": {
+        "sec": {"type": "integer", "minimum": 0},
+        "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999},
+    },
+}
+_DURATION = {
+    "type": "object",
+    "title": "duration",
+    "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer", "minimum": 0}},
+}
+_VEC3 = {
+    "type": "object",
+    "title": "foxglove.Vector3",
+    "properties": {k: {"type": "number"} for k in ("x", "y", "z")},
+}
+_VEC2 = {
+    "type": "object",
+    "title": "foxglove.Vector2",
+    "properties": {k: {"type": "number"} for k in ("x", "y")},
+}
+_QUAT = {
+    "type": "object",
+    "title": "foxglove.Quaternion",
+    "properties": {k: {"type": "number"} for k in ("x", "y", "z", "w")},
+}
+_POSE = {
+    "type": "object",
+    "title": "foxglove.Pose",
+    "properties": {"position": _VEC3, "orientation": _QUAT},
+}
+_COLOR = {
+    "type": "object",
+    "title": "foxglove.Color",
+    "properties": {k: {"type": "number", "minimum": 0, "maximum": 1} for k in "rgba"},
+}
+_KEY_VALUE = {
+    "type": "object",
+    "title": "foxglove.KeyValuePair",
+    "properties": {"key": {"type": "string"}, "value": {"type": "string"}},
+}
+_CUBE = {
+    "type": "object",
+    "title": "foxglove.CubePrimitive",
+    "properties": {"pose": _POSE, "size": _VEC3, "color": _COLOR},
+}
+_EMPTY_LIST = {"type": "array", "items": {"type": "object"}}
+
+
+def _object(title: str, properties: dict[str, Any]) -> dict[str, Any]:
+    return {"type": "object", "title": title, "properties": properties}
+
+
+WELL_KNOWN_SCHEMAS: dict[str, dict[str, Any]] = {
+    "foxglove.Log": _object(
+        "foxglove.Log",
+        {
+            "timestamp": _TIME,
+            "level": {
+                "type": "integer",
+                "enum": [int(v) for v in LogLevel],
+                "description": "0 unknown, 1 debug, 2 info, 3 warning, 4 error, 5 fatal",
+            },
+            "message": {"type": "string"},
+            "name": {"type": "string"},
+            "file": {"type": "string"},
+            "line": {"type": "integer", "minimum": 0},
+        },
+    ),
+    "foxglove.PoseInFrame": _object(
+        "foxglove.PoseInFrame",
+        {"timestamp": _TIME, "frame_id": {"type": "string"}, "pose": _POSE},
+    ),
+    "foxglove.FrameTransform": _object(
+        "foxglove.FrameTransform",
+        {
+            "timestamp": _TIME,
+            "parent_frame_id": {"type": "string"},
+            "child_frame_id": {"type": "string"},
+            "translation": _VEC3,
+            "rotation": _QUAT,
+        },
+    ),
+    "foxglove.SceneUpdate": _object(
+        "foxglove.SceneUpdate",
+        {
+            "deletions": {
+                "type": "array",
+                "items": _object(
+                    "foxglove.SceneEntityDeletion",
+                    {"timestamp": _TIME, "type": {"type": "integer"}, "id": {"type": "string"}},
+                ),
+            },
+            "entities": {
+                "type": "array",
+                "items": _object(
+                    "foxglove.SceneEntity",
+                    {
+                        "timestamp": _TIME,
+                        "frame_id": {"type": "string"},
+                        "id": {"type": "string"},
+                        "lifetime": _DURATION,
+                        "frame_locked": {"type": "boolean"},
+                        "metadata": {"type": "array", "items": _KEY_VALUE},
+                        "arrows": _EMPTY_LIST,
+                        "cubes": {"type": "array", "items": _CUBE},
+                        "spheres": _EMPTY_LIST,
+                        "cylinders": _EMPTY_LIST,
+                        "lines": _EMPTY_LIST,
+                        "triangles": _EMPTY_LIST,
+                        "texts": _EMPTY_LIST,
+                        "models": _EMPTY_LIST,
+                    },
+                ),
+            },
+        },
+    ),
+    "foxglove.Grid": _object(
+        "foxglove.Grid",
+        {
+            "timestamp": _TIME,
+            "frame_id": {"type": "string"},
+            "pose": _POSE,
+            "column_count": {"type": "integer", "minimum": 0},
+            "cell_size": _VEC2,
+            "row_stride": {"type": "integer", "minimum": 0},
+            "cell_stride": {"type": "integer", "minimum": 0},
+            "fields": {
+                "type": "array",
+                "items": _object(
+                    "foxglove.PackedElementField",
+                    {
+                        "name": {"type": "string"},
+                        "offset": {"type": "integer", "minimum": 0},
+                        "type": {"type": "integer", "description": "7 = FLOAT32"},
+                    },
+                ),
+            },
+            "data": {"type": "string", "contentEncoding": "base64"},
+        },
+    ),
+}
+
+
+def time_dict(t_ns: int) -> dict[str, int]:
+    """Nanoseconds since the epoch → Foxglove `{"sec", "nsec"}`."""
+    sec, nsec = divmod(int(t_ns), 1_000_000_000)
+    return {"sec": sec, "nsec": nsec}
+
+
+def _vec3(v: Sequence[float]) -> dict[str, float]:
+    x, y, z = (float(c) for c in v)
+    return {"x": x, "y": y, "z": z}
+
+
+def _quat_wxyz(q: Sequence[float]) -> dict[str, float]:
+    w, x, y, z = (float(c) for c in q)
+    return {"x": x, "y": y, "z": z, "w": w}
+
+
+_IDENTITY_Q = (1.0, 0.0, 0.0, 0.0)
+# NED as seen from an east-north-up display frame: a half turn about (1, 1, 0)/√2.
+Q_ENU_NED: Quat = (0.0, math.sqrt(0.5), math.sqrt(0.5), 0.0)
+
+
+def foxglove_pose(
+    pos_n: Sequence[float], q_nb: Sequence[float] = _IDENTITY_Q, *, frame_id: str = NED_FRAME
+) -> FoxgloveMessage:
+    """A vehicle pose in NED (position m, quaternion w-x-y-z body→NED) as foxglove.PoseInFrame."""
+    return FoxgloveMessage(
+        "foxglove.PoseInFrame",
+        {
+            "frame_id": frame_id,
+            "pose": {"position": _vec3(pos_n), "orientation": _quat_wxyz(q_nb)},
+        },
+    )
+
+
+def foxglove_transform(
+    parent_frame_id: str,
+    child_frame_id: str,
+    translation: Sequence[float] = (0.0, 0.0, 0.0),
+    q_parent_child: Sequence[float] = _IDENTITY_Q,
+) -> FoxgloveMessage:
+    """A foxglove.FrameTransform: the child frame's pose in the parent (quaternion w-x-y-z)."""
+    return FoxgloveMessage(
+        "foxglove.FrameTransform",
+        {
+            "parent_frame_id": parent_frame_id,
+            "child_frame_id": child_frame_id,
+            "translation": _vec3(translation),
+            "rotation": _quat_wxyz(q_parent_child),
+        },
+    )
+
+
+def foxglove_vehicle_transform(
+    vehicle: str, pos_n: Sequence[float], q_nb: Sequence[float]
+) -> FoxgloveMessage:
+    """The vehicle's body frame in NED as a transform, so a 3D panel can follow it."""
+    return foxglove_transform(NED_FRAME, vehicle, pos_n, q_nb)
+
+
+def ned_display_transform() -> FoxgloveMessage:
+    """The static transform from the z-up display frame "world" to "ned"."""
+    return foxglove_transform(DISPLAY_FRAME, NED_FRAME, (0.0, 0.0, 0.0), Q_ENU_NED)
+
+
+def _as_box(box: SceneBox | tuple[Sequence[float], Sequence[float]]) -> SceneBox:
+    if isinstance(box, SceneBox):
+        return box
+    lo, hi = box
+    return SceneBox(min_n=tuple(lo), max_n=tuple(hi))  # type: ignore[arg-type]
+
+
+def foxglove_scene_from_boxes(
+    boxes: Iterable[SceneBox | tuple[Sequence[float], Sequence[float]]],
+    *,
+    entity_id: str = "world",
+    frame_id: str = NED_FRAME,
+) -> FoxgloveMessage:
+    """World boxes (SceneBox, or (min corner, max corner) pairs in NED) as a foxglove.SceneUpdate.
+
+    All boxes go in one entity as `cubes[]`; a later update with the same `entity_id` replaces it.
+    """
+    cubes = []
+    for raw in boxes:
+        box = _as_box(raw)
+        lo = np.asarray(box.min_n, dtype=float)
+        hi = np.asarray(box.max_n, dtype=float)
+        if lo.shape != (3,) or hi.shape != (3,) or np.any(hi < lo):
+            raise ValueError(f"box {box.id or raw!r}: max corner must be ≥ min corner in x, y, z")
+        r, g, b, a = (float(c) for c in box.color_rgba)
+        center = _vec3((lo + hi) / 2.0)
+        cubes.append(
+            {
+                "pose": {"position": center, "orientation": _quat_wxyz(_IDENTITY_Q)},
+                "size": _vec3(hi - lo),
+                "color": {"r": r, "g": g, "b": b, "a": a},
+            }
+        )
+    entity = {
+        "frame_id": frame_id,
+        "id": entity_id,
+        "lifetime": {"sec": 0, "nsec": 0},
+        "frame_locked": False,
+        "metadata": [],
+        "arrows": [],
+        "cubes": cubes,
+        "spheres": [],
+        "cylinders": [],
+        "lines": [],
+        "triangles": [],
+        "texts": [],
+        "models": [],
+    }
+    return FoxgloveMessage("foxglove.SceneUpdate", {"deletions": [], "entities": [entity]})
+
+
+def foxglove_grid(
+    values_2d: Any,
+    cell_size_m: float | tuple[float, float],
+    origin: Sequence[float],
+    *,
+    frame_id: str = NED_FRAME,
+    field_name: str = "value",
+) -> FoxgloveMessage:
+    """A 2-D map (e.g. radiation counts) as a foxglove.Grid of FLOAT32 cells.
+
+    `values_2d[row, col]`: columns run along the frame's +x (north), rows along +y (east);
+    `origin` is the (x, y[, z]) NED corner of cell (0, 0). NaN cells stay NaN (drawn empty).
+    """
+    grid = np.asarray(values_2d, dtype="<f4")
+    if grid.ndim != 2 or grid.size == 0:
+        raise ValueError(f"grid values must be a non-empty 2-D array, got shape {grid.shape}")
+    if isinstance(cell_size_m, tuple):
+        cx, cy = (float(c) for c in cell_size_m)
+    else:
+        cx = cy = float(cell_size_m)
+    if not (cx > 0 and cy > 0):
+        raise ValueError(f"grid cell size must be > 0 m, got {cell_size_m!r}")
+    ox, oy, *rest = (float(c) for c in origin)
+    oz = rest[0] if rest else 0.0
+    cols = grid.shape[1]
+    cell_stride = 4
+    return FoxgloveMessage(
+        "foxglove.Grid",
+        {
+            "frame_id": frame_id,
+            "pose": {"position": _vec3((ox, oy, oz)), "orientation": _quat_wxyz(_IDENTITY_Q)},
+            "column_count": int(cols),
+            "cell_size": {"x": cx, "y": cy},
+            "row_stride": int(cols) * cell_stride,
+            "cell_stride": cell_stride,
+            "fields": [{"name": field_name, "offset": 0, "type": int(NumericType.FLOAT32)}],
+            "data": base64.b64encode(np.ascontiguousarray(grid).tobytes()).decode("ascii"),
+        },
+    )
+
+
+def foxglove_log(level: LogLevel, text: str, name: str) -> FoxgloveMessage:
+    """A foxglove.Log line (the recorder fills its timestamp)."""
+    return FoxgloveMessage(
+        "foxglove.Log",
+        {"level": int(level), "message": text, "name": name, "file": "", "line": 0},
+    )
+
+
+def grid_values(message: Mapping[str, Any]) -> np.ndarray:
+    """Decode a recorded foxglove.Grid back to its `values_2d` array (FLOAT32 field 0)."""
+    cols = int(message["column_count"])
+    raw = base64.b64decode(message["data"])
+    flat = np.frombuffer(raw, dtype="<f4")
+    return flat.reshape(-1, cols)

@@ -1,0 +1,113 @@
+"""A synchronous MCAP writer: JSON messages with JSON Schemas, one channel per topic.
+
+The recorder drives it from its background thread; recovery and tlog import use it directly.
+Chunks are zstd-compressed; `flush()` ends the open chunk and hands it to the OS, which is what
+makes a killed process lose only what came after the last flush.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import IO, Any
+
+from mcap.well_known import MessageEncoding, SchemaEncoding
+from mcap.writer import CompressionType, Writer
+
+from logs.encoding import encode_json
+from logs.errors import RecordingError
+from logs.foxglove import WELL_KNOWN_SCHEMAS, time_dict
+
+PROFILE = ""
+LIBRARY = "quadgcs-logs"
+CHUNK_SIZE_BYTES = 512 * 1024
+
+
+def schema_name_for_topic(topic: str) -> str:
+    """A schema name for a dict payload that brought none: derived from the topic."""
+    return "quadgcs" + topic.replace("/", ".")
+
+
+class McapSink:
+    """Write JSON messages to an MCAP file; schemas and channels register on first use."""
+
+    def __init__(self, path: Path, *, chunk_size: int = CHUNK_SIZE_BYTES) -> None:
+        self.path = Path(path)
+        try:
+            self._file: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 (closed in close())
+        except OSError as exc:
+            raise RecordingError(f"{self.path}: cannot write: {exc.strerror or exc}") from exc
+        self._writer = Writer(
+            self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD
+        )
+        self._writer.start(profile=PROFILE, library=LIBRARY)
+        self._channels: dict[str, int] = {}
+        self._schemas: dict[tuple[str, str], int] = {}
+        self._sequence: dict[int, int] = {}
+        self._closed = False
+
+    def has_topic(self, topic: str) -> bool:
+        """True once a channel exists for `topic`."""
+        return topic in self._channels
+
+    def add_topic(self, topic: str, schema_name: str, schema: Mapping[str, Any]) -> int:
+        """Register `topic` with a JSON Schema (reused when name and text match)."""
+        text = json.dumps(schema, separators=(",", ":"), sort_keys=True)
+        key = (schema_name, text)
+        schema_id = self._schemas.get(key)
+        if schema_id is None:
+            schema_id = self._writer.register_schema(
+                name=schema_name, encoding=SchemaEncoding.JSONSchema, data=text.encode()
+            )
+            self._schemas[key] = schema_id
+        channel_id = self._writer.register_channel(
+            topic=topic, message_encoding=MessageEncoding.JSON, schema_id=schema_id
+        )
+        self._channels[topic] = channel_id
+        self._sequence[channel_id] = 0
+        return channel_id
+
+    def add_well_known_topic(self, topic: str, schema_name: str) -> int:
+        """Register `topic` with one of Foxglove's well-known schemas."""
+        return self.add_topic(topic, schema_name, WELL_KNOWN_SCHEMAS[schema_name])
+
+    def write(
+        self, topic: str, log_time_ns: int, message: Mapping[str, Any], *, stamp: bool = False
+    ) -> None:
+        """Write one JSON message on a registered topic; `stamp` fills `timestamp` from log time."""
+        if stamp and "timestamp" not in message:
+            message = {"timestamp": time_dict(log_time_ns), **message}
+        self.write_bytes(topic, log_time_ns, encode_json(message))
+
+    def write_bytes(self, topic: str, log_time_ns: int, data: bytes) -> None:
+        """Write already-encoded JSON on a registered topic."""
+        channel_id = self._channels[topic]
+        seq = self._sequence[channel_id] + 1
+        self._sequence[channel_id] = seq
+        self._writer.add_message(
+            channel_id=channel_id,
+            log_time=log_time_ns,
+            publish_time=log_time_ns,
+            data=data,
+            sequence=seq,
+        )
+
+    def write_metadata(self, name: str, data: Mapping[str, str]) -> None:
+        """An MCAP Metadata record (string → string)."""
+        self._writer.add_metadata(name, {str(k): str(v) for k, v in data.items()})
+        self._file.flush()
+
+    def flush(self) -> None:
+        """End the open chunk and push everything written so far to the OS."""
+        self._writer.flush()
+
+    def close(self) -> None:
+        """Write the summary and index, then close the file."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._writer.finish()
+        finally:
+            self._file.close()

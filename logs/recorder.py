@@ -1,0 +1,351 @@
+"""Flight recorder: the station's loop thread queues records; a background thread writes MCAP.
+
+`put`, `put_raw` and `event` only append to a queue (no disk, no JSON on the caller's thread), so
+a 25 ms control tick pays well under a millisecond for recording. The writer thread converts
+payloads, writes zstd chunks and flushes at least every `flush_interval_s`, so a process killed
+with SIGKILL loses at most its last interval. A full queue drops and counts, never silently.
+
+Time: records carry the station's monotonic `t_s`; log times are nanoseconds on a UTC-anchored
+timeline, `anchor_ns + t_s·1e9`, with `anchor_ns = wall clock − monotonic clock` taken once at
+start, so the file's times read as UTC yet never jump when the wall clock is adjusted.
+"""
+
+from __future__ import annotations
+
+import atexit
+import base64
+import dataclasses
+import datetime as dt
+import enum
+import json
+import threading
+import time
+from collections import deque
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+from logs.encoding import schema_for_payload, to_jsonable
+from logs.errors import RecordingError
+from logs.foxglove import FoxgloveMessage, LogLevel, foxglove_log, ned_display_transform
+from logs.mcap_sink import McapSink, schema_name_for_topic
+from logs.topics import LOG_TOPIC, MAVLINK_RX_TOPIC, MAVLINK_TX_TOPIC, TF_TOPIC
+
+DEFAULT_DIR = Path("flights")
+METADATA_NAME = "quadgcs.flight"
+RAW_FRAME_SCHEMA_NAME = "quadgcs.MavlinkFrame"
+RAW_FRAME_SCHEMA: dict[str, Any] = {
+    "type": "object",
+    "title": "MAVLink frame",
+    "description": "One raw MAVLink frame as it crossed the link, base64",
+    "properties": {
+        "data": {"type": "string", "contentEncoding": "base64"},
+        "len": {"type": "integer", "minimum": 0},
+    },
+}
+
+
+class Direction(enum.Enum):
+    """Which way a raw MAVLink frame crossed the link."""
+
+    RX = "rx"
+    TX = "tx"
+
+
+RAW_TOPICS = {Direction.RX: MAVLINK_RX_TOPIC, Direction.TX: MAVLINK_TX_TOPIC}
+
+
+class _Kind(enum.Enum):
+    PUT = 1
+    RAW = 2
+    EVENT = 3
+    METADATA = 4
+
+
+@dataclass(frozen=True, slots=True)
+class RecorderStats:
+    """What the recorder did, per topic: written, dropped (queue full or closed), rejected."""
+
+    written: dict[str, int]
+    dropped: dict[str, int]
+    rejected: dict[str, int]
+    queued: int
+    flushes: int
+    error: str | None
+
+    @property
+    def total_written(self) -> int:
+        """Messages written over all topics."""
+        return sum(self.written.values())
+
+    @property
+    def total_dropped(self) -> int:
+        """Messages dropped over all topics."""
+        return sum(self.dropped.values())
+
+
+def flight_file_name(started_utc: dt.datetime, vehicle: str) -> str:
+    """`2026-11-22T10-31-05Z_vehicle1.mcap`: sortable, and safe on every file system."""
+    safe_vehicle = "".join(c if c.isalnum() or c in "-_" else "_" for c in vehicle) or "vehicle"
+    return f"{started_utc.strftime('%Y-%m-%dT%H-%M-%SZ')}_{safe_vehicle}.mcap"
+
+
+def _resolve_path(path_or_dir: str | Path, started_utc: dt.datetime, vehicle: str) -> Path:
+    target = Path(path_or_dir)
+    if target.suffix == ".mcap" and not target.is_dir():
+        parent = target.parent
+    else:
+        parent = target
+        target = target / flight_file_name(started_utc, vehicle)
+        base = target.stem
+        n = 1
+        while target.exists():
+            target = parent / f"{base}-{n}.mcap"
+            n += 1
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RecordingError(f"{parent}: cannot create directory: {exc.strerror or exc}") from exc
+    return target
+
+
+def _software_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("quadgcs")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def encode_metadata(metadata: Mapping[str, Any]) -> dict[str, str]:
+    """MCAP metadata is string → string: non-strings become JSON, listed under `json_keys`."""
+    out: dict[str, str] = {}
+    json_keys = []
+    for key, value in metadata.items():
+        if isinstance(value, str):
+            out[str(key)] = value
+        else:
+            out[str(key)] = json.dumps(to_jsonable(value), separators=(",", ":"))
+            json_keys.append(str(key))
+    if json_keys:
+        out["json_keys"] = json.dumps(json_keys)
+    return out
+
+
+def _log_level(level: LogLevel | int | str) -> LogLevel:
+    try:
+        if isinstance(level, str):
+            name = level.strip().upper()
+            return LogLevel.WARNING if name == "WARN" else LogLevel[name]
+        return LogLevel(int(level))
+    except (KeyError, ValueError) as exc:
+        names = ", ".join(m.name.lower() for m in LogLevel)
+        raise RecordingError(f"log level {level!r}: expected one of {names}") from exc
+
+
+class Recorder:
+    """Record one flight to an MCAP file (see the module docstring)."""
+
+    def __init__(
+        self,
+        path_or_dir: str | Path = DEFAULT_DIR,
+        *,
+        metadata: Mapping[str, Any],
+        vehicle: str = "vehicle1",
+        flush_interval_s: float = 1.0,
+        max_queue: int = 100_000,
+        anchor_ns: int | None = None,
+    ) -> None:
+        if not flush_interval_s > 0:
+            raise RecordingError(f"flush_interval_s must be > 0 s, got {flush_interval_s!r}")
+        wall_ns = time.time_ns()
+        self._anchor_ns = wall_ns - time.monotonic_ns() if anchor_ns is None else int(anchor_ns)
+        started = dt.datetime.fromtimestamp(wall_ns / 1e9, tz=dt.UTC)
+        self.vehicle = vehicle
+        self._path = _resolve_path(path_or_dir, started, vehicle)
+        self._sink = McapSink(self._path)
+        self._flush_interval_s = float(flush_interval_s)
+        self._max_queue = int(max_queue)
+        self._queue: deque[tuple[_Kind, str, float, Any]] = deque()
+        self._wake = threading.Event()
+        self._closing = False
+        self._closed = False
+        self._drop_lock = threading.Lock()
+        self._written: dict[str, int] = {}
+        self._dropped: dict[str, int] = {}
+        self._rejected: dict[str, int] = {}
+        self._flushes = 0
+        self._error: str | None = None
+        header = {
+            "vehicle": vehicle,
+            "software_version": _software_version(),
+            "started_utc": started.isoformat().replace("+00:00", "Z"),
+            "anchor_ns": str(self._anchor_ns),
+            **dict(metadata),
+        }
+        self._sink.write_metadata(METADATA_NAME, encode_metadata(header))
+        first_ns = self._anchor_ns + time.monotonic_ns()
+        self._write_foxglove(TF_TOPIC, first_ns, ned_display_transform())
+        self._sink.flush()
+        self._thread = threading.Thread(
+            target=self._run, name=f"recorder-{vehicle}", daemon=True
+        )
+        self._thread.start()
+        atexit.register(self.close)
+
+    @property
+    def path(self) -> Path:
+        """The MCAP file being written."""
+        return self._path
+
+    @property
+    def anchor_ns(self) -> int:
+        """UTC nanoseconds at monotonic zero: log_time_ns = anchor_ns + t_s·1e9."""
+        return self._anchor_ns
+
+    def log_time_ns(self, t_s: float) -> int:
+        """A monotonic time in seconds on this recording's UTC timeline, ns."""
+        return self._anchor_ns + round(t_s * 1e9)
+
+    @property
+    def stats(self) -> RecorderStats:
+        """A snapshot of the per-topic counters."""
+        return RecorderStats(
+            written=dict(self._written),
+            dropped=dict(self._dropped),
+            rejected=dict(self._rejected),
+            queued=len(self._queue),
+            flushes=self._flushes,
+            error=self._error,
+        )
+
+    # The four calls below run on the station's loop thread: queue only, never block.
+
+    def put(self, topic: str, t_s: float, payload: Any) -> None:
+        """Queue a record (dataclass, dict or FoxgloveMessage) on `topic` at monotonic `t_s`."""
+        if isinstance(payload, dict):
+            payload = dict(payload)  # the caller may reuse its dict after this returns
+        self._enqueue(_Kind.PUT, topic, t_s, payload)
+
+    def put_raw(self, direction: Direction | str, t_s: float, data: bytes) -> None:
+        """Queue one raw MAVLink frame, "rx" (from the vehicle) or "tx" (to it)."""
+        try:
+            topic = RAW_TOPICS[Direction(direction)]
+        except ValueError as exc:
+            raise RecordingError(f"direction {direction!r}: expected 'rx' or 'tx'") from exc
+        self._enqueue(_Kind.RAW, topic, t_s, bytes(data))
+
+    def event(self, t_s: float, level: LogLevel | int | str, text: str) -> None:
+        """Queue a human-readable event as a foxglove.Log line on "/log"."""
+        self._enqueue(_Kind.EVENT, LOG_TOPIC, t_s, (_log_level(level), str(text)))
+
+    def add_metadata(self, name: str, data: Mapping[str, Any]) -> None:
+        """Queue an extra metadata record (e.g. the parameter snapshot once it has arrived)."""
+        self._enqueue(_Kind.METADATA, name, 0.0, dict(data))
+
+    def _enqueue(self, kind: _Kind, topic: str, t_s: float, payload: Any) -> None:
+        if self._closing or len(self._queue) >= self._max_queue:
+            with self._drop_lock:
+                self._dropped[topic] = self._dropped.get(topic, 0) + 1
+            return
+        self._queue.append((kind, topic, t_s, payload))
+
+    def close(self) -> None:
+        """Drain the queue, write the summary and index, close the file. Idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self._closing = True
+        atexit.unregister(self.close)
+        self._wake.set()
+        self._thread.join()
+        try:
+            self._sink.close()
+        except OSError as exc:
+            self._error = self._error or f"{self._path}: {exc.strerror or exc}"
+
+    def __enter__(self) -> Recorder:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    # Writer thread.
+
+    def _run(self) -> None:
+        next_flush = time.monotonic() + self._flush_interval_s
+        queue = self._queue
+        while True:
+            while queue:
+                item = queue.popleft()
+                if self._error is None:
+                    self._write_item(*item)
+                else:
+                    with self._drop_lock:
+                        self._dropped[item[1]] = self._dropped.get(item[1], 0) + 1
+            now = time.monotonic()
+            if self._closing and not queue:
+                break
+            if now >= next_flush:
+                self._flush()
+                next_flush = now + self._flush_interval_s
+            self._wake.wait(timeout=min(0.02, max(0.0, next_flush - now)))
+            self._wake.clear()
+
+    def _flush(self) -> None:
+        if self._error is not None:
+            return
+        try:
+            self._sink.flush()
+            self._flushes += 1
+        except OSError as exc:
+            self._error = f"{self._path}: {exc.strerror or exc}"
+
+    def _write_item(self, kind: _Kind, topic: str, t_s: float, payload: Any) -> None:
+        try:
+            if kind is _Kind.METADATA:
+                self._sink.write_metadata(topic, encode_metadata(payload))
+                return
+            log_ns = self._anchor_ns + round(t_s * 1e9)
+            if kind is _Kind.RAW:
+                if not self._sink.has_topic(topic):
+                    self._sink.add_topic(topic, RAW_FRAME_SCHEMA_NAME, RAW_FRAME_SCHEMA)
+                message = {"data": base64.b64encode(payload).decode("ascii"), "len": len(payload)}
+                self._sink.write(topic, log_ns, message)
+            elif kind is _Kind.EVENT:
+                level, text = payload
+                self._write_foxglove(topic, log_ns, foxglove_log(level, text, self.vehicle))
+            elif isinstance(payload, FoxgloveMessage):
+                self._write_foxglove(topic, log_ns, payload)
+            else:
+                self._write_record(topic, log_ns, payload)
+        except OSError as exc:
+            self._error = f"{self._path}: {exc.strerror or exc}"
+            self._dropped[topic] = self._dropped.get(topic, 0) + 1
+            return
+        except (TypeError, ValueError, KeyError, RecursionError):
+            self._rejected[topic] = self._rejected.get(topic, 0) + 1
+            return
+        self._written[topic] = self._written.get(topic, 0) + 1
+
+    def _write_foxglove(self, topic: str, log_ns: int, message: FoxgloveMessage) -> None:
+        if not self._sink.has_topic(topic):
+            self._sink.add_well_known_topic(topic, message.schema_name)
+        self._sink.write(topic, log_ns, message.data, stamp=True)
+
+    def _write_record(self, topic: str, log_ns: int, payload: Any) -> None:
+        if not (isinstance(payload, Mapping) or dataclasses.is_dataclass(payload)):
+            raise TypeError(f"payload on {topic} must be a dataclass or a dict")
+        message = to_jsonable(payload)
+        if not self._sink.has_topic(topic):
+            name, schema = schema_for_payload(payload, message)
+            self._sink.add_topic(topic, name or schema_name_for_topic(topic), schema)
+        self._sink.write(topic, log_ns, message)
