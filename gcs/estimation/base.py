@@ -1,0 +1,206 @@
+"""What every altitude estimator shares: parameters, the estimate record, sonar gating."""
+
+from __future__ import annotations
+
+import enum
+import math
+from abc import ABC, abstractmethod
+from collections import deque
+from dataclasses import dataclass
+
+from firmware_link.records import Attitude, Imu, Rangefinder
+from gcs.estimation.inputs import sonar_altitude_m, vertical_accel_up_mps2
+
+
+@dataclass(frozen=True, slots=True)
+class EstimatorParams:
+    """Estimator tuning; sonar limits are the HC-SR04's (thesis sec. 5.2)."""
+
+    sonar_min_m: float = 0.02
+    sonar_max_m: float = 4.0
+    sonar_sigma_m: float = 0.02  # measurement noise used by the filters (σ 1 cm + tilt/latency)
+    accel_sigma_mps2: float = 0.5  # per-sample vertical accel noise incl. motor vibration
+    bias_walk_mps2_per_sqrt_s: float = 0.01
+    initial_bias_sigma_mps2: float = 0.2
+    gate_sigma: float = 4.0  # Kalman innovation gate, in innovation standard deviations
+    gate_m: float = 0.3  # complementary filter's fixed innovation gate
+    reacquire_count: int = 6  # rejected readings in the window needed to reset to the sonar
+    reacquire_spread_m: float = 0.08  # max spread of those readings (steady sonar)
+    reacquire_window_s: float = 0.5
+    reacquire_min_s: float = 1.5  # rejections must last longer than the carpet's late echoes
+    duplicate_window_s: float = 0.2  # an identical distance within this time is a repeat
+    stale_after_s: float = 0.25  # no accepted sonar for longer: coasting on the accelerometer
+    ground_alt_m: float = 0.10  # below this estimate a zero sonar reading means "on the floor"
+    complementary_tc_s: float = 1.0  # T of the third-order filter (gains 3/T, 3/T², 1/T³)
+    max_dt_s: float = 0.2  # longer gaps (a stalled link) are integrated as this at most
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.sonar_min_m < self.sonar_max_m:
+            raise ValueError("need 0 <= sonar_min_m < sonar_max_m")
+        positive = ("sonar_sigma_m", "accel_sigma_mps2", "gate_sigma", "gate_m",
+                    "complementary_tc_s", "max_dt_s")
+        for name in positive:
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f"{name} must be > 0")
+        if self.reacquire_count < 2:
+            raise ValueError("reacquire_count must be >= 2")
+
+
+class SonarStatus(enum.Enum):
+    """What happened to the sonar on this step."""
+
+    NONE = "none"  # no new reading
+    USED = "used"
+    GROUND = "ground"  # zero reading near the floor, used as altitude 0
+    INVALID = "invalid"  # out of range / zero in the air
+    DUPLICATE = "duplicate"  # the same reading again (stream faster than the sensor)
+    REJECTED = "rejected"  # failed the innovation gate (outlier, late echo)
+    REACQUIRED = "reacquired"  # consistent readings after rejections: estimate reset to them
+
+
+@dataclass(frozen=True, slots=True)
+class AltEstimate:
+    """Altitude estimate (up positive) and its diagnostics."""
+
+    t_s: float
+    alt_m: float
+    vel_mps: float
+    acc_mps2: float  # bias-corrected upward acceleration used this step
+    bias_mps2: float  # estimated accelerometer bias (vertical)
+    sonar_used: bool
+    sonar_status: SonarStatus
+    innovation_m: float  # sonar altitude minus predicted altitude (0 when none)
+    sonar_age_s: float  # time since the last accepted sonar reading (inf before any)
+    coasting: bool  # no accepted sonar for longer than stale_after_s
+    alt_sigma_m: float  # the filter's own standard deviation, nan when it has none
+    rejected_total: int
+
+
+class AltEstimator(ABC):
+    """Common driver: time step, attitude, accelerometer and sonar conditioning, gating.
+
+    Subclasses implement the propagation (`_predict`), the correction (`_correct`) and the gate
+    test (`_gate`)."""
+
+    name = "base"
+
+    def __init__(self, params: EstimatorParams | None = None) -> None:
+        self.params = params or EstimatorParams()
+        self._t_s: float | None = None
+        self._roll = 0.0
+        self._pitch = 0.0
+        self._acc_up = 0.0
+        self._last_sonar_t_s = -math.inf
+        self._last_distance: float | None = None
+        self._last_distance_t_s = -math.inf
+        self._rejected: deque[tuple[float, float]] = deque()  # (t_s, sonar alt), consecutive
+        self._rejected_total = 0
+        self._initialised = False
+        self._reject_run_start_s = 0.0
+
+    @abstractmethod
+    def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
+
+    @abstractmethod
+    def _gate(self, z_alt_m: float) -> bool:
+        """True when the reading passes the innovation gate."""
+
+    @abstractmethod
+    def _correct(self, z_alt_m: float, t_s: float) -> None: ...
+
+    @abstractmethod
+    def _reset_alt(self, alt_m: float) -> None: ...
+
+    @abstractmethod
+    def _state(self) -> tuple[float, float, float, float]:
+        """(alt_m, vel_mps, bias_mps2, alt_sigma_m)."""
+
+    def update(
+        self,
+        imu: Imu | None,
+        sonar: Rangefinder | None,
+        attitude: Attitude | None,
+        t_s: float,
+    ) -> AltEstimate:
+        """Advance to `t_s` with the newest samples (None = nothing new since the last step)."""
+        p = self.params
+        if attitude is not None:
+            self._roll, self._pitch = attitude.roll_rad, attitude.pitch_rad
+        if imu is not None:
+            self._acc_up = vertical_accel_up_mps2(imu.acc_b, self._roll, self._pitch)
+        dt = 0.0 if self._t_s is None else min(max(t_s - self._t_s, 0.0), p.max_dt_s)
+        self._t_s = t_s
+        if dt > 0.0:
+            self._predict(self._acc_up, dt)
+        alt_before = self._state()[0]
+
+        status = SonarStatus.NONE
+        innovation = 0.0
+        if sonar is not None:
+            status, innovation = self._sonar(sonar, t_s, alt_before)
+        alt, vel, bias, sigma = self._state()
+        age = t_s - self._last_sonar_t_s
+        return AltEstimate(
+            t_s=t_s,
+            alt_m=alt,
+            vel_mps=vel,
+            acc_mps2=self._acc_up - bias,
+            bias_mps2=bias,
+            sonar_used=status in (SonarStatus.USED, SonarStatus.GROUND, SonarStatus.REACQUIRED),
+            sonar_status=status,
+            innovation_m=innovation,
+            sonar_age_s=age,
+            coasting=age > p.stale_after_s,
+            alt_sigma_m=sigma,
+            rejected_total=self._rejected_total,
+        )
+
+    def _sonar(self, sonar: Rangefinder, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
+        p = self.params
+        d = sonar.distance_m
+        in_range = sonar.valid and p.sonar_min_m <= d <= p.sonar_max_m
+        if not in_range:
+            if d <= p.sonar_min_m and alt_pred < p.ground_alt_m:
+                # the HC-SR04 reads 0 below its minimum: on the floor, that *is* the altitude
+                self._correct(0.0, t_s)
+                self._initialised = True
+                self._last_sonar_t_s = t_s
+                return SonarStatus.GROUND, -alt_pred
+            return SonarStatus.INVALID, 0.0
+        if d == self._last_distance and t_s - self._last_distance_t_s < p.duplicate_window_s:
+            return SonarStatus.DUPLICATE, 0.0
+        self._last_distance, self._last_distance_t_s = d, t_s
+        z = sonar_altitude_m(d, self._roll, self._pitch)
+        innovation = z - alt_pred
+        if not self._initialised:
+            # the first in-range reading sets the altitude; nothing to gate it against yet
+            self._initialised = True
+            self._reset_alt(z)
+            self._last_sonar_t_s = t_s
+            return SonarStatus.USED, innovation
+        if self._gate(z):
+            self._rejected.clear()
+            self._correct(z, t_s)
+            self._last_sonar_t_s = t_s
+            return SonarStatus.USED, innovation
+        self._rejected_total += 1
+        if self._rejected and t_s - self._rejected[-1][0] > p.stale_after_s:
+            self._rejected.clear()  # not consecutive: readings were accepted or absent between
+        if not self._rejected:
+            self._reject_run_start_s = t_s
+        self._rejected.append((t_s, z))
+        while self._rejected[0][0] < t_s - p.reacquire_window_s:
+            self._rejected.popleft()
+        recent = [r for _, r in self._rejected]
+        if (
+            t_s - self._reject_run_start_s >= p.reacquire_min_s
+            and len(recent) >= p.reacquire_count
+            and max(recent) - min(recent) <= p.reacquire_spread_m
+        ):
+            # the sonar has disagreed for longer than any late echo lasts and now reads steadily
+            # (a box under the vehicle, or the estimate drifted while coasting): believe it
+            self._reset_alt(z)
+            self._rejected.clear()
+            self._last_sonar_t_s = t_s
+            return SonarStatus.REACQUIRED, innovation
+        return SonarStatus.REJECTED, innovation

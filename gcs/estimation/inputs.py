@@ -1,0 +1,27 @@
+"""Sensor conditioning shared by the estimators: vertical acceleration and sonar altitude."""
+
+from __future__ import annotations
+
+import math
+
+from firmware_link.records import Vec3
+
+GRAVITY_MPS2 = 9.80665
+
+
+def vertical_accel_up_mps2(acc_b: Vec3, roll_rad: float, pitch_rad: float) -> float:
+    """Upward kinematic acceleration from body specific force (FRD) and roll/pitch.
+
+    acc_n_z = (R_nb · f_b)_z + g with R_nb's third row (-sinθ, sinφ·cosθ, cosφ·cosθ); at rest the
+    accelerometer reads f_b = (0, 0, -g), so acc_n_z = 0. Up is -z. Yaw does not enter the z row.
+    """
+    fx, fy, fz = acc_b
+    sp, cp = math.sin(pitch_rad), math.cos(pitch_rad)
+    sr, cr = math.sin(roll_rad), math.cos(roll_rad)
+    acc_n_z = -sp * fx + sr * cp * fy + cr * cp * fz + GRAVITY_MPS2
+    return -acc_n_z
+
+
+def sonar_altitude_m(distance_m: float, roll_rad: float, pitch_rad: float) -> float:
+    """Height above the floor from a body-z slant range: distance · cos(roll) · cos(pitch)."""
+    return distance_m * math.cos(roll_rad) * math.cos(pitch_rad)
