@@ -50,7 +50,7 @@ def decode_metadata(records: Iterable[tuple[str, Mapping[str, str]]]) -> dict[st
     return merged
 
 
-def _read_whole_records(path: Path) -> tuple[list[Any], bool]:
+def read_whole_records(path: Path) -> tuple[list[Any], bool]:
     """Every whole record of a possibly truncated file, and whether it ended cleanly."""
     records: list[Any] = []
     with open(path, "rb") as stream:
@@ -110,7 +110,7 @@ class Recording:
         self._end_ns = stats.message_end_time
 
     def _load_linear(self) -> None:
-        records, _clean = _read_whole_records(self.path)
+        records, _clean = read_whole_records(self.path)
         messages: list[tuple[int, int, int, bytes]] = []
         for record in records:
             if isinstance(record, Schema):
