@@ -1,7 +1,15 @@
-"""Errors the link raises; the CLI prints them as one line and exits 1."""
+"""Errors the link raises; the CLI prints them as one line and exits with `exit_code`."""
 
 from __future__ import annotations
 
 
 class LinkError(Exception):
     """The link could not be opened, or the vehicle refused or did not answer a command."""
+
+    exit_code = 1
+
+
+class LinkUsageError(LinkError):
+    """The caller asked for something malformed (bad connection string, bad key file): exit 2."""
+
+    exit_code = 2

@@ -1,0 +1,117 @@
+"""Frames in and out of one transport: parse, count, tap raw bytes, encode, sign.
+
+Parsing uses pymavlink's MAVLink 2 parser (it reads MAVLink 1 frames too) in robust mode, so
+garbage and bad CRCs come back as BAD_DATA and are counted, never raised. Encoding uses the
+MAVLink 1 module for a MAVLink 1 vehicle (no extension fields, no signing) and the MAVLink 2
+module otherwise.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from firmware_link.protocol import WireVersion, mavlink, mavlink1
+from firmware_link.stats import StatsTally
+from firmware_link.transport import ByteTransport, TransportClosed
+
+RawTap = Callable[[str, float, bytes], None]
+RX = "rx"
+TX = "tx"
+_SIGNATURE_REASON = "Invalid signature"
+_PREFIX_REASON = "Bad prefix"
+
+
+class _NoFile:
+    """pymavlink's MAVLink object wants a file; frames are written by the endpoint instead."""
+
+    def write(self, data: bytes) -> None:
+        """Never used: the endpoint packs and writes frames itself."""
+
+
+class FrameEndpoint:
+    """Decoded messages from a transport, and encoded messages to it, with stats and a tap."""
+
+    def __init__(
+        self,
+        transport: ByteTransport | None,
+        *,
+        source_system: int,
+        source_component: int,
+        clock: Callable[[], float],
+        on_raw: RawTap | None = None,
+    ) -> None:
+        self.transport = transport
+        self.tally = StatsTally()
+        self._clock = clock
+        self._on_raw = on_raw
+        self.parser = mavlink.MAVLink(_NoFile(), source_system, source_component)
+        self.parser.robust_parsing = True
+        self._encoder_v1 = mavlink1.MAVLink(_NoFile(), source_system, source_component)
+        self.wire = WireVersion.V1
+
+    @property
+    def encoder(self) -> Any:
+        """The pymavlink object whose `*_encode` methods build outgoing messages."""
+        return self._encoder_v1 if self.wire is WireVersion.V1 else self.parser
+
+    def set_signing(self, key: bytes | None, *, link_id: int, timestamp: int) -> None:
+        """Sign every outgoing frame and refuse unsigned ones (key None: stop signing)."""
+        signing = self.parser.signing
+        signing.secret_key = key
+        signing.sign_outgoing = key is not None
+        signing.allow_unsigned_callback = None
+        signing.link_id = link_id
+        signing.timestamp = max(signing.timestamp, timestamp)
+
+    def receive(self) -> list[Any]:
+        """Decoded good messages from whatever bytes arrived (raises TransportClosed)."""
+        if self.transport is None:
+            return []
+        data = self.transport.read()
+        if not data:
+            return []
+        return self.feed(data)
+
+    def feed(self, data: bytes) -> list[Any]:
+        """Parse `data`; count and drop what is bad; tap and return what is good."""
+        now = self._clock()
+        self.tally.rx_bytes += len(data)
+        out = []
+        for msg in self.parser.parse_buffer(data) or ():
+            if msg.get_type() == "BAD_DATA":
+                reason = str(getattr(msg, "reason", ""))
+                if reason == _SIGNATURE_REASON:
+                    self.tally.signature_refusals += 1
+                else:
+                    if reason != _PREFIX_REASON:
+                        self.tally.bad_frames += 1
+                    self.tally.garbage_bytes += len(msg.data)
+                continue
+            header = msg.get_header()
+            self.tally.frame_received(header.srcSystem, header.srcComponent, header.seq, now)
+            if self._on_raw is not None:
+                self._on_raw(RX, now, bytes(msg.get_msgbuf()))
+            out.append(msg)
+        return out
+
+    def send(self, msg: Any) -> bool:
+        """Encode and write one message; False (counted) when there is no transport."""
+        if self.transport is None:
+            self.tally.tx_dropped += 1
+            return False
+        encoder = self.encoder
+        frame = bytes(msg.pack(encoder))
+        encoder.seq = (encoder.seq + 1) % 256
+        # Both encoders share one sequence so a dialect switch never looks like a gap.
+        self._encoder_v1.seq = self.parser.seq = encoder.seq
+        try:
+            self.transport.write(frame)
+        except TransportClosed:
+            self.tally.tx_dropped += 1
+            raise
+        self.tally.tx_messages += 1
+        self.tally.tx_bytes += len(frame)
+        if self._on_raw is not None:
+            self._on_raw(TX, self._clock(), frame)
+        return True

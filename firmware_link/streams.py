@@ -1,0 +1,270 @@
+"""Telemetry stream planning: which message at which rate fits the link, and the bring-up steps.
+
+The byte budget is payload + frame overhead (MAVLink 1: 8 bytes; MAVLink 2: 12, +13 signed)
+times rate, summed, against the medium's capacity (115200 baud 8N1 ≈ 11,520 B/s). Network links
+have no capacity limit here (None). `plan_streams` is pure and tested without a link.
+
+ArduCopter 3.2.1 can only set rates per stream group (`REQUEST_DATA_STREAM`, integer Hz), so
+messages of one group share its rate; 4.x sets each message (`SET_MESSAGE_INTERVAL`).
+
+Bring-up follows thesis §6.1: the sampling period was lowered from 100 ms to 25 ms in five steps
+of about 100 ms each so the serial link would not choke. Here the steps are equal in period
+(100, 85, 70, 55, 40, 25 ms → 10, 11.8, 14.3, 18.2, 25, 40 Hz) and each holds long enough to
+measure the ATTITUDE rate reached (100 ms is too short to count a 10 Hz stream).
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from firmware_link.errors import LinkError
+from firmware_link.protocol import WireVersion, frame_overhead_bytes, payload_bytes
+from firmware_link.records import Dialect
+
+
+class DataStream(enum.IntEnum):
+    """MAV_DATA_STREAM groups of REQUEST_DATA_STREAM."""
+
+    RAW_SENSORS = 1
+    EXTENDED_STATUS = 2
+    RC_CHANNELS = 3
+    POSITION = 6
+    EXTRA1 = 10
+    EXTRA2 = 11
+    EXTRA3 = 12
+
+
+@dataclass(frozen=True, slots=True)
+class StreamWanted:
+    """A message the station wants, at `rate_hz`, and the least it can live with."""
+
+    message: str
+    rate_hz: float
+    min_rate_hz: float
+    group: DataStream
+
+
+@dataclass(frozen=True, slots=True)
+class StreamRate:
+    """One planned message: its rate and what it costs on the wire."""
+
+    message: str
+    group: DataStream
+    rate_hz: float
+    frame_bytes: int
+    bytes_per_s: float
+
+
+@dataclass(frozen=True, slots=True)
+class StreamPlan:
+    """Rates chosen to fit the link, and the budget they use."""
+
+    capacity_bytes_per_s: float | None
+    wire: WireVersion
+    signed: bool
+    rates: tuple[StreamRate, ...]
+
+    @property
+    def total_bytes_per_s(self) -> float:
+        """Bytes per second the planned streams put on the link."""
+        return sum(r.bytes_per_s for r in self.rates)
+
+    @property
+    def utilisation_pct(self) -> float | None:
+        """Share of the link's capacity used, percent; None on an unlimited link."""
+        if self.capacity_bytes_per_s is None:
+            return None
+        return 100.0 * self.total_bytes_per_s / self.capacity_bytes_per_s
+
+    def rate_of(self, message: str) -> float:
+        """Planned rate of `message` in Hz (0 when not planned)."""
+        return next((r.rate_hz for r in self.rates if r.message == message), 0.0)
+
+    def group_rates(self) -> dict[DataStream, float]:
+        """Rate of each stream group (the fastest of its messages)."""
+        out: dict[DataStream, float] = {}
+        for r in self.rates:
+            out[r.group] = max(out.get(r.group, 0.0), r.rate_hz)
+        return out
+
+    def budget_lines(self) -> list[str]:
+        """The budget as a table a person reads: one line per message, then the total."""
+        lines = [f"{'message':<18}{'rate Hz':>9}{'frame B':>9}{'B/s':>9}"]
+        for r in self.rates:
+            lines.append(
+                f"{r.message:<18}{r.rate_hz:>9.1f}{r.frame_bytes:>9d}{r.bytes_per_s:>9.0f}"
+            )
+        cap = self.capacity_bytes_per_s
+        if cap is None:
+            lines.append(
+                f"total {self.total_bytes_per_s:.0f} B/s (network link, no capacity limit)"
+            )
+        else:
+            lines.append(
+                f"total {self.total_bytes_per_s:.0f} B/s of {cap:.0f} B/s "
+                f"({self.utilisation_pct:.1f} % of the link)"
+            )
+        return lines
+
+
+def _frame_bytes(message: str, wire: WireVersion, signed: bool) -> int:
+    return payload_bytes(message, wire) + frame_overhead_bytes(wire, signed)
+
+
+def plan_streams(
+    capacity_bytes_per_s: float | None,
+    wanted: Sequence[StreamWanted],
+    *,
+    wire: WireVersion = WireVersion.V2,
+    signed: bool = False,
+    grouped: bool = False,
+    max_utilisation: float = 0.8,
+) -> StreamPlan:
+    """Choose rates that fit `max_utilisation` of the capacity, earlier entries first.
+
+    Every entry first gets its minimum rate; then, in the order given (priority), each is raised
+    toward its wanted rate as far as the remaining budget allows. With `grouped`, entries of one
+    stream group move together (REQUEST_DATA_STREAM). Raises LinkError when even the minimum
+    rates do not fit. The headroom left is for STATUSTEXT, PARAM_VALUE and the companion board.
+    """
+    if not 0.0 < max_utilisation <= 1.0:
+        raise ValueError(f"max_utilisation {max_utilisation} outside (0, 1]")
+    blocks: dict[object, list[StreamWanted]] = {}
+    for w in wanted:
+        if w.rate_hz <= 0 or w.min_rate_hz < 0 or w.min_rate_hz > w.rate_hz:
+            raise ValueError(f"{w.message}: need 0 <= min_rate_hz <= rate_hz and rate_hz > 0")
+        blocks.setdefault(w.group if grouped else w.message, []).append(w)
+    cost = {
+        key: sum(_frame_bytes(w.message, wire, signed) for w in members)
+        for key, members in blocks.items()
+    }
+    rate = {key: max(w.min_rate_hz for w in members) for key, members in blocks.items()}
+    budget = None if capacity_bytes_per_s is None else capacity_bytes_per_s * max_utilisation
+    if budget is not None:
+        used = sum(cost[k] * rate[k] for k in blocks)
+        if used > budget:
+            raise LinkError(
+                f"telemetry minimum needs {used:.0f} B/s but the link carries "
+                f"{budget:.0f} B/s ({max_utilisation:.0%} of {capacity_bytes_per_s:.0f})"
+            )
+        for key, members in blocks.items():
+            want = max(w.rate_hz for w in members)
+            spare = budget - sum(cost[k] * rate[k] for k in blocks)
+            rate[key] = min(want, rate[key] + spare / cost[key])
+            if grouped:
+                # REQUEST_DATA_STREAM takes whole Hz; round down so the plan still fits.
+                rate[key] = max(float(int(rate[key])), max(w.min_rate_hz for w in members))
+    else:
+        rate = {key: max(w.rate_hz for w in members) for key, members in blocks.items()}
+    rates = tuple(
+        StreamRate(
+            message=w.message,
+            group=w.group,
+            rate_hz=rate[w.group if grouped else w.message],
+            frame_bytes=_frame_bytes(w.message, wire, signed),
+            bytes_per_s=_frame_bytes(w.message, wire, signed)
+            * rate[w.group if grouped else w.message],
+        )
+        for w in wanted
+    )
+    return StreamPlan(capacity_bytes_per_s, wire, signed, rates)
+
+
+def wanted_streams(dialect: Dialect, target_rate_hz: float = 40.0) -> tuple[StreamWanted, ...]:
+    """The station's telemetry wish list for a firmware, most important first."""
+    fast = target_rate_hz
+    ds = DataStream
+    if dialect is Dialect.APM25:
+        return (
+            StreamWanted("ATTITUDE", fast, 10.0, ds.EXTRA1),
+            StreamWanted("SIMSTATE", fast, 10.0, ds.EXTRA1),
+            StreamWanted("RAW_IMU", fast, 10.0, ds.RAW_SENSORS),
+            StreamWanted("SCALED_PRESSURE", fast, 10.0, ds.RAW_SENSORS),
+            StreamWanted("RANGEFINDER", fast, 10.0, ds.EXTRA3),
+            StreamWanted("VFR_HUD", 10.0, 2.0, ds.EXTRA2),
+            StreamWanted("SYS_STATUS", 2.0, 1.0, ds.EXTENDED_STATUS),
+            StreamWanted("RC_CHANNELS_RAW", 5.0, 1.0, ds.RC_CHANNELS),
+            StreamWanted("SERVO_OUTPUT_RAW", 5.0, 1.0, ds.RC_CHANNELS),
+        )
+    return (
+        StreamWanted("ATTITUDE", fast, 10.0, ds.EXTRA1),
+        StreamWanted("RAW_IMU", fast, 10.0, ds.RAW_SENSORS),
+        StreamWanted("DISTANCE_SENSOR", fast, 10.0, ds.EXTRA3),
+        StreamWanted("VFR_HUD", 10.0, 2.0, ds.EXTRA2),
+        StreamWanted("SYS_STATUS", 2.0, 1.0, ds.EXTENDED_STATUS),
+        StreamWanted("SCALED_PRESSURE", 10.0, 1.0, ds.RAW_SENSORS),
+        StreamWanted("RC_CHANNELS", 5.0, 1.0, ds.RC_CHANNELS),
+        StreamWanted("SERVO_OUTPUT_RAW", 5.0, 1.0, ds.RC_CHANNELS),
+        StreamWanted("SIM_STATE", 10.0, 1.0, ds.EXTRA1),
+    )
+
+
+def bring_up_periods_ms(
+    start_ms: float = 100.0, end_ms: float = 25.0, steps: int = 5
+) -> tuple[float, ...]:
+    """Sampling periods from `start_ms` down to `end_ms` in `steps` equal steps (thesis §6.1)."""
+    if steps < 1 or end_ms <= 0 or start_ms < end_ms:
+        raise ValueError("need steps >= 1 and start_ms >= end_ms > 0")
+    return tuple(start_ms - (start_ms - end_ms) * k / steps for k in range(steps + 1))
+
+
+def step_plan(plan: StreamPlan, period_ms: float, *, whole_hz: bool) -> dict[str, float]:
+    """Per-message rates for one bring-up step: the plan, capped at 1/period."""
+    cap_hz = 1000.0 / period_ms
+    out: dict[str, float] = {}
+    for r in plan.rates:
+        hz = min(r.rate_hz, cap_hz)
+        out[r.message] = float(max(1, round(hz))) if whole_hz else hz
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class BringUpStep:
+    """One bring-up step: the ATTITUDE rate asked for and the rate measured."""
+
+    period_ms: float
+    requested_hz: float
+    measured_hz: float
+
+
+@dataclass(frozen=True, slots=True)
+class BringUpReport:
+    """Outcome of link bring-up: the plan, each step, and the rates reached at the end."""
+
+    dialect: Dialect
+    plan: StreamPlan
+    steps: tuple[BringUpStep, ...]
+    achieved_hz: tuple[tuple[str, float], ...]
+    target_rate_hz: float
+    reached: bool  # ATTITUDE within the tolerance of the target at the last step
+
+    def achieved(self, message: str) -> float:
+        """Rate measured for `message` over the final window (0 when none arrived)."""
+        return dict(self.achieved_hz).get(message, 0.0)
+
+    def summary_lines(self) -> list[str]:
+        """Human-readable bring-up report: steps, budget, achieved rates."""
+        lines = [f"link bring-up ({self.dialect.value}):"]
+        for s in self.steps:
+            lines.append(
+                f"  step {s.period_ms:5.1f} ms: ATTITUDE asked {s.requested_hz:5.1f} Hz, "
+                f"got {s.measured_hz:5.1f} Hz"
+            )
+        lines.extend("  " + line for line in self.plan.budget_lines())
+        for name, hz in self.achieved_hz:
+            lines.append(
+                f"  achieved {name:<18}{hz:6.1f} Hz (planned {self.plan.rate_of(name):.1f})"
+            )
+        lines.append("  target reached" if self.reached else "  target NOT reached")
+        return lines
+
+
+def measured_rate_hz(stamps_s: Sequence[float], window_s: float) -> float:
+    """Arrival rate from receive times inside one window: intervals over their span."""
+    if len(stamps_s) >= 3:
+        span = stamps_s[-1] - stamps_s[0]
+        if span > 0:
+            return (len(stamps_s) - 1) / span
+    return len(stamps_s) / window_s if window_s > 0 else 0.0

@@ -1,0 +1,285 @@
+"""Byte transports under the link: TCP, UDP in/out, serial (pyserial). Non-blocking reads.
+
+Every failure to open ends in one LinkError line naming the connection string. A TCP connect is
+bounded by `connect_timeout_s` (pymavlink would retry for ≈ 2 s); reopening after a loss uses a
+non-blocking connect so `poll()` never waits on it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import select
+import socket
+from typing import Protocol
+
+import serial
+
+from firmware_link.connection import ConnectionSpec, Transport
+from firmware_link.errors import LinkError
+
+READ_CHUNK_BYTES = 65536
+WRITE_TIMEOUT_S = 0.5
+
+
+class TransportClosed(LinkError):
+    """The peer went away (TCP EOF, serial device gone)."""
+
+
+class ByteTransport(Protocol):
+    """What the link needs from a transport."""
+
+    def read(self) -> bytes: ...
+    def write(self, data: bytes) -> None: ...
+    def wait_readable(self, timeout_s: float) -> None: ...
+    def close(self) -> None: ...
+    def fileno(self) -> int: ...
+
+
+def _wait(fd: int, timeout_s: float) -> None:
+    if fd >= 0:
+        select.select([fd], [], [], max(0.0, timeout_s))
+
+
+class TcpTransport:
+    """A TCP client socket; reads never block."""
+
+    def __init__(self, spec: ConnectionSpec, sock: socket.socket) -> None:
+        self.spec = spec
+        self._sock = sock
+
+    @classmethod
+    def connect(cls, spec: ConnectionSpec, timeout_s: float) -> TcpTransport:
+        """Connect now, giving up after `timeout_s`."""
+        try:
+            sock = socket.create_connection((spec.host, spec.port), timeout=timeout_s)
+        except ConnectionRefusedError:
+            raise LinkError(
+                f"{spec.url}: connection refused (nothing listens on {spec.host}:{spec.port})"
+            ) from None
+        except TimeoutError:
+            raise LinkError(
+                f"{spec.url}: no answer from {spec.host}:{spec.port} within {timeout_s:.1f} s"
+            ) from None
+        except OSError as exc:
+            raise LinkError(f"{spec.url}: cannot connect: {exc.strerror or exc}") from None
+        return cls._ready(spec, sock)
+
+    @classmethod
+    def _ready(cls, spec: ConnectionSpec, sock: socket.socket) -> TcpTransport:
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        sock.settimeout(WRITE_TIMEOUT_S)
+        return cls(spec, sock)
+
+    @classmethod
+    def start_connect(cls, spec: ConnectionSpec) -> socket.socket | None:
+        """Begin a non-blocking connect; None when it failed at once."""
+        try:
+            infos = socket.getaddrinfo(spec.host, spec.port, type=socket.SOCK_STREAM)
+        except OSError:
+            return None
+        family, kind, proto, _, addr = infos[0]
+        sock = socket.socket(family, kind, proto)
+        sock.setblocking(False)
+        code = sock.connect_ex(addr)
+        if code not in (0, errno.EINPROGRESS, errno.EWOULDBLOCK):
+            sock.close()
+            return None
+        return sock
+
+    @classmethod
+    def finish_connect(cls, spec: ConnectionSpec, sock: socket.socket) -> TcpTransport | None:
+        """The transport if a started connect has completed; raises OSError if it failed."""
+        _, writable, _ = select.select([], [sock], [], 0)
+        if not writable:
+            return None
+        code = sock.getsockopt(socket.SOL_SOCKET, socket.SO_ERROR)
+        if code:
+            sock.close()
+            raise OSError(code, "connect failed")
+        return cls._ready(spec, sock)
+
+    def read(self) -> bytes:
+        """Whatever bytes have arrived; raises TransportClosed on EOF."""
+        chunks = []
+        while True:
+            try:
+                data = self._sock.recv(READ_CHUNK_BYTES, socket.MSG_DONTWAIT)
+            except (BlockingIOError, InterruptedError):
+                break
+            except OSError as exc:
+                raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
+            if not data:
+                if chunks:
+                    break
+                raise TransportClosed(f"{self.spec.url}: peer closed the connection")
+            chunks.append(data)
+            if len(data) < READ_CHUNK_BYTES:
+                break
+        return b"".join(chunks)
+
+    def write(self, data: bytes) -> None:
+        """Send all of `data`; raises TransportClosed if the peer is gone."""
+        try:
+            self._sock.sendall(data)
+        except OSError as exc:
+            raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
+
+    def wait_readable(self, timeout_s: float) -> None:
+        """Block until bytes arrive or `timeout_s` passes."""
+        _wait(self.fileno(), timeout_s)
+
+    def fileno(self) -> int:
+        """The socket's descriptor."""
+        return self._sock.fileno()
+
+    def close(self) -> None:
+        """Close the socket."""
+        self._sock.close()
+
+
+class UdpTransport:
+    """UDP: `udpin` listens and answers whoever spoke last; `udpout` sends to a fixed peer."""
+
+    def __init__(self, spec: ConnectionSpec, sock: socket.socket, peer: tuple | None) -> None:
+        self.spec = spec
+        self._sock = sock
+        self._peer = peer
+
+    @classmethod
+    def open(cls, spec: ConnectionSpec) -> UdpTransport:
+        """Bind (udpin) or aim (udpout) a UDP socket."""
+        try:
+            infos = socket.getaddrinfo(spec.host, spec.port, type=socket.SOCK_DGRAM)
+            family, kind, proto, _, addr = infos[0]
+            sock = socket.socket(family, kind, proto)
+            if spec.transport is Transport.UDPIN:
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+                sock.bind(addr)
+                peer = None
+            else:
+                peer = addr
+        except OSError as exc:
+            raise LinkError(f"{spec.url}: cannot open UDP socket: {exc.strerror or exc}") from None
+        sock.setblocking(False)
+        return cls(spec, sock, peer)
+
+    @property
+    def local_port(self) -> int:
+        """The bound port (useful with udpin:...:0)."""
+        return int(self._sock.getsockname()[1])
+
+    def read(self) -> bytes:
+        """All datagrams waiting, concatenated (MAVLink frames never span datagrams)."""
+        chunks = []
+        while True:
+            try:
+                data, addr = self._sock.recvfrom(READ_CHUNK_BYTES)
+            except (BlockingIOError, InterruptedError):
+                break
+            except OSError:
+                # ICMP port unreachable from a udpout peer that is not up yet: not fatal.
+                break
+            if self.spec.transport is Transport.UDPIN:
+                self._peer = addr
+            chunks.append(data)
+        return b"".join(chunks)
+
+    def write(self, data: bytes) -> None:
+        """Send one datagram to the peer (dropped until a udpin peer has spoken)."""
+        if self._peer is None:
+            return
+        # UDP is lossy by nature; the watchdog notices a dead peer.
+        with contextlib.suppress(OSError):
+            self._sock.sendto(data, self._peer)
+
+    def wait_readable(self, timeout_s: float) -> None:
+        """Block until a datagram arrives or `timeout_s` passes."""
+        _wait(self.fileno(), timeout_s)
+
+    def fileno(self) -> int:
+        """The socket's descriptor."""
+        return self._sock.fileno()
+
+    def close(self) -> None:
+        """Close the socket."""
+        self._sock.close()
+
+
+class SerialTransport:
+    """A serial device (or pseudo-terminal) through pyserial, opened exclusively."""
+
+    def __init__(self, spec: ConnectionSpec, port: serial.Serial) -> None:
+        self.spec = spec
+        self._port = port
+
+    @classmethod
+    def open(cls, spec: ConnectionSpec) -> SerialTransport:
+        """Open the device at its baud; a busy or missing device is one LinkError line."""
+        try:
+            port = serial.Serial(
+                spec.device,
+                baudrate=spec.baud,
+                timeout=0,
+                write_timeout=WRITE_TIMEOUT_S,
+                exclusive=True,
+            )
+        except serial.SerialException as exc:
+            text = str(exc)
+            if "busy" in text.lower() or "lock" in text.lower():
+                reason = "device is busy (another program has it open)"
+            elif "No such file" in text or "could not open" in text:
+                reason = "no such device"
+            else:
+                reason = text
+            raise LinkError(f"{spec.url}: cannot open serial port: {reason}") from None
+        except (OSError, ValueError) as exc:
+            raise LinkError(f"{spec.url}: cannot open serial port: {exc}") from None
+        return cls(spec, port)
+
+    def read(self) -> bytes:
+        """Whatever bytes are waiting; raises TransportClosed when the device vanished."""
+        try:
+            waiting = self._port.in_waiting
+            if not waiting:
+                readable, _, _ = select.select([self._port.fileno()], [], [], 0)
+                if not readable:
+                    return b""
+                data = self._port.read(READ_CHUNK_BYTES)
+                if not data:
+                    raise TransportClosed(f"{self.spec.url}: serial device closed")
+                return bytes(data)
+            return bytes(self._port.read(waiting))
+        except (serial.SerialException, OSError) as exc:
+            raise TransportClosed(f"{self.spec.url}: serial device lost: {exc}") from None
+
+    def write(self, data: bytes) -> None:
+        """Write all of `data`."""
+        try:
+            self._port.write(data)
+        except (serial.SerialException, OSError) as exc:
+            raise TransportClosed(f"{self.spec.url}: serial write failed: {exc}") from None
+
+    def wait_readable(self, timeout_s: float) -> None:
+        """Block until bytes arrive or `timeout_s` passes."""
+        _wait(self.fileno(), timeout_s)
+
+    def fileno(self) -> int:
+        """The device's descriptor (-1 once closed)."""
+        try:
+            return int(self._port.fileno())
+        except (serial.SerialException, AttributeError, ValueError):
+            return -1
+
+    def close(self) -> None:
+        """Close the device."""
+        self._port.close()
+
+
+def open_transport(spec: ConnectionSpec, connect_timeout_s: float = 1.0) -> ByteTransport:
+    """Open the transport a connection string names (blocking for TCP, at most the timeout)."""
+    if spec.transport is Transport.TCP:
+        return TcpTransport.connect(spec, connect_timeout_s)
+    if spec.transport is Transport.SERIAL:
+        return SerialTransport.open(spec)
+    return UdpTransport.open(spec)
