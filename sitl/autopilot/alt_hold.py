@@ -1,0 +1,153 @@
+"""ArduCopter's vertical position controller (AC_PosControl z axis), in cm as the firmware.
+
+position error × POS_Z_P → climb-rate target; velocity error × VEL_Z_P → acceleration target;
+acceleration error → PID (ACCEL_Z P/I/D/IMAX) whose output, in 1/1000 of throttle, is added to
+the hover throttle. The hover throttle is learned while holding still (Copter 3.2.1's
+throttle_average, 4.x's MOT_HOVER_LEARN), which is what keeps the integrator small.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sitl.autopilot.gains import Gains
+from sitl.autopilot.pid import Pid, PidTerms
+
+ACCEL_Z_MAX_CMSS = 250.0  # target acceleration bound (PILOT_ACCEL_Z)
+ACCEL_FILT_HZ = 20.0
+HOVER_LEARN_TC_S = 2.0
+LEASH_CM = 300.0  # max altitude error kept in the target, as the firmware's leash
+
+
+@dataclass(frozen=True)
+class AltHoldOutput:
+    """One step's result: throttle 0..1 plus the cascade's intermediate targets."""
+
+    throttle: float
+    target_alt_cm: float
+    target_climb_cms: float
+    target_accel_cmss: float
+    accel_terms: PidTerms
+
+
+class AltitudeController:
+    """Position → velocity → acceleration cascade driving the collective throttle."""
+
+    def __init__(self, gains: Gains, hover_throttle: float) -> None:
+        self.gains = gains
+        self.hover_throttle = hover_throttle
+        self.target_alt_cm = 0.0
+        self._pid = Pid(gains.acc_z)
+        self._acc_filtered = 0.0
+        self._limit_low = False
+        self._limit_high = False
+
+    def set_gains(self, gains: Gains) -> None:
+        """Adopt new gains, keeping the integrator."""
+        integrator = self._pid.integrator
+        self.gains = gains
+        self._pid = Pid(gains.acc_z)
+        self._pid._integrator = max(-gains.acc_z.imax, min(gains.acc_z.imax, integrator))
+
+    def reset(self, alt_cm: float, throttle_now: float) -> None:
+        """Start holding `alt_cm` without a throttle jump (integrator absorbs the difference)."""
+        self.target_alt_cm = alt_cm
+        self._pid.reset()
+        self._pid._integrator = (throttle_now - self.hover_throttle) * 1000.0
+        self._acc_filtered = 0.0
+
+    def update(
+        self,
+        climb_rate_cms: float,
+        alt_cm: float,
+        vel_cms: float,
+        accel_cmss: float,
+        dt_s: float,
+        tilt_cos: float = 1.0,
+    ) -> AltHoldOutput:
+        """Move the target at `climb_rate_cms` and return the throttle to follow it."""
+        g = self.gains
+        # don't let the target run away while the motors are saturated
+        if not (
+            (self._limit_high and climb_rate_cms > 0) or (self._limit_low and climb_rate_cms < 0)
+        ):
+            self.target_alt_cm += climb_rate_cms * dt_s
+        self.target_alt_cm = min(alt_cm + LEASH_CM, max(alt_cm - LEASH_CM, self.target_alt_cm))
+        vel_target = g.pos_z_p * (self.target_alt_cm - alt_cm) + climb_rate_cms
+        acc_target = g.vel_z_p * (vel_target - vel_cms)
+        acc_target = min(ACCEL_Z_MAX_CMSS, max(-ACCEL_Z_MAX_CMSS, acc_target))
+        alpha = dt_s / (dt_s + 1.0 / (2.0 * math.pi * ACCEL_FILT_HZ))
+        err = acc_target - accel_cmss
+        self._acc_filtered += alpha * (err - self._acc_filtered)
+        terms = self._pid.update(
+            self._acc_filtered, dt_s, limit_i=self._limit_high or self._limit_low
+        )
+        thr = self.hover_throttle + terms.total / 1000.0
+        # tilt compensation: more collective when leaning (as the firmware's angle boost)
+        thr /= max(0.5, tilt_cos)
+        self._limit_high = thr >= 1.0
+        self._limit_low = thr <= g.thr_min
+        thr = min(1.0, max(g.thr_min, thr))
+        return AltHoldOutput(thr, self.target_alt_cm, vel_target, acc_target, terms)
+
+    @property
+    def limit_low(self) -> bool:
+        """The throttle demand is at its lower bound (used by the land detector)."""
+        return self._limit_low
+
+    def learn_hover(self, throttle: float, climb_ms: float, dt_s: float) -> None:
+        """Track the throttle that holds altitude while the vehicle is nearly still vertically."""
+        if abs(climb_ms) < 0.6:
+            alpha = dt_s / (HOVER_LEARN_TC_S + dt_s)
+            self.hover_throttle = min(
+                0.8, max(0.1, self.hover_throttle + alpha * (throttle - self.hover_throttle))
+            )
+
+
+class SurfaceTracker:
+    """Copter 3.2.1's sonar surface tracking: keeps the sonar distance where the pilot left it.
+
+    Sonar reads are trusted after 3 good reads in a row and only up to 60 % of its range.
+    The correction to the climb rate is (target − sonar) × RNGFND_GAIN, bounded to 1.5 m/s.
+    """
+
+    HEALTH_MAX = 3
+    VELZ_MAX_CMS = 150.0
+
+    def __init__(self) -> None:
+        self.health = 0
+        self.sonar_alt_cm: float | None = None
+        self.target_cm: float | None = None
+
+    def reading(self, distance_m: float | None, tilt_cos: float, gains: Gains) -> None:
+        """Feed a new sonar reading (None = no echo / out of range)."""
+        ok = (
+            distance_m is not None
+            and gains.rng_min_m < distance_m < 0.6 * gains.rng_max_m
+            and tilt_cos > 0.7
+        )
+        if ok:
+            assert distance_m is not None
+            self.sonar_alt_cm = distance_m * tilt_cos * 100.0
+            self.health = min(self.HEALTH_MAX, self.health + 1)
+        else:
+            self.health = 0
+
+    @property
+    def healthy(self) -> bool:
+        """True once enough good reads arrived."""
+        return self.health >= self.HEALTH_MAX and self.sonar_alt_cm is not None
+
+    def climb_rate(self, target_rate_cms: float, dt_s: float, gain: float) -> float:
+        """Pilot climb rate corrected to keep the surface distance."""
+        if not self.healthy:
+            self.target_cm = None
+            return target_rate_cms
+        assert self.sonar_alt_cm is not None
+        if self.target_cm is None:
+            self.target_cm = self.sonar_alt_cm
+        self.target_cm += target_rate_cms * dt_s
+        correction = (self.target_cm - self.sonar_alt_cm) * gain
+        correction = min(self.VELZ_MAX_CMS, max(-self.VELZ_MAX_CMS, correction))
+        return target_rate_cms + correction

@@ -1,0 +1,121 @@
+"""MAVLink framing for one side of one link: encode with a fixed source, decode and count junk.
+
+Uses pymavlink's generated ardupilotmega dialect (MAVLink 2 module, which also reads and writes
+MAVLink 1 frames). A MAVLink-1-only codec (Copter 3.2.1 on the APM 2.5) sends v1 frames and
+drops v2 frames it receives, counting them as bad, as that firmware's parser does.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+MAVLINK2_MAGIC = 0xFD
+SIGNING_KEY_BYTES = 32
+SIGNING_EPOCH_UNIX_S = 1420070400  # MAVLink signing epoch, 2015-01-01
+# Messages Copter 4.x accepts unsigned on a signed link (radio modems inject RADIO_STATUS).
+UNSIGNED_ALLOWED_IDS = frozenset({mavlink.MAVLINK_MSG_ID_RADIO_STATUS})
+
+
+class SigningKeyError(ValueError):
+    """A signing key file that cannot be used."""
+
+
+def load_signing_key(path: str | Path) -> bytes:
+    """Key file: 32 raw bytes, or a one-line passphrase whose SHA-256 is the key (as MAVProxy)."""
+    file = Path(path)
+    try:
+        data = file.read_bytes()
+    except OSError as exc:
+        raise SigningKeyError(f"signing key {file}: cannot read: {exc.strerror or exc}") from None
+    if len(data) == SIGNING_KEY_BYTES:
+        return data
+    try:
+        text = data.decode("utf-8").strip()
+    except UnicodeDecodeError:
+        raise SigningKeyError(
+            f"signing key {file}: {len(data)} bytes of binary; expected 32 bytes or a passphrase"
+        ) from None
+    if not text or "\n" in text:
+        raise SigningKeyError(f"signing key {file}: expected 32 raw bytes or a one-line passphrase")
+    return hashlib.sha256(text.encode("utf-8")).digest()
+
+
+class _Sink:
+    """File-like target for pymavlink's send(): collects the packed frame."""
+
+    def __init__(self) -> None:
+        self.frames: list[bytes] = []
+
+    def write(self, data: bytes) -> None:
+        self.frames.append(bytes(data))
+
+
+@dataclass
+class CodecStats:
+    """Counters of one codec."""
+
+    rx_ok: int = 0
+    rx_bad: int = 0  # CRC errors, garbage, refused signatures, wrong protocol version
+    tx: int = 0
+
+
+class MavCodec:
+    """Encoder/decoder with source (sysid, compid)."""
+
+    def __init__(self, sysid: int, compid: int, mavlink1_only: bool) -> None:
+        self._sink = _Sink()
+        self.mav = mavlink.MAVLink(self._sink, srcSystem=sysid, srcComponent=compid)
+        self.mav.robust_parsing = True
+        self.mavlink1_only = mavlink1_only
+        self.stats = CodecStats()
+
+    def set_signing(self, key: bytes | None, timestamp_s: Callable[[], float]) -> None:
+        """Sign outgoing and require signed incoming frames (None turns signing off)."""
+        s = self.mav.signing
+        if key is None or key == bytes(SIGNING_KEY_BYTES):
+            s.secret_key = None
+            s.sign_outgoing = False
+            s.allow_unsigned_callback = None
+            return
+        s.secret_key = key
+        s.sign_outgoing = True
+        s.link_id = 0
+        s.timestamp = max(s.timestamp, int((timestamp_s() - SIGNING_EPOCH_UNIX_S) * 100_000))
+        s.allow_unsigned_callback = lambda _mav, msg_id: msg_id in UNSIGNED_ALLOWED_IDS
+
+    @property
+    def signing(self) -> bool:
+        """Whether signing is on."""
+        return self.mav.signing.secret_key is not None
+
+    def encode(self, msg: Any) -> bytes:
+        """Pack one message (sequence and signature applied)."""
+        self.mav.send(msg, force_mavlink1=self.mavlink1_only)
+        self.stats.tx += 1
+        return self._sink.frames.pop()
+
+    def decode(self, data: bytes) -> list[Any]:
+        """Parse bytes; return whole good messages, counting everything dropped."""
+        out: list[Any] = []
+        try:
+            msgs = self.mav.parse_buffer(data) or []
+        except mavlink.MAVError:
+            self.stats.rx_bad += 1
+            return out
+        for msg in msgs:
+            kind = msg.get_type()
+            if kind == "BAD_DATA" or kind.startswith("UNKNOWN"):
+                self.stats.rx_bad += 1
+                continue
+            if self.mavlink1_only and msg.get_msgbuf()[0] == MAVLINK2_MAGIC:
+                self.stats.rx_bad += 1
+                continue
+            self.stats.rx_ok += 1
+            out.append(msg)
+        return out
