@@ -1,0 +1,574 @@
+"""EPBHA: the Exploration Priority Based Heuristic Approach to online 3D path planning (Ch. 8).
+
+The vehicle knows its position and the goal, nothing of the obstacles, and sees only its six
+0.5 m IR cones. Each step it either estimates the cost of its four in-plane grid neighbours and
+moves to the cheapest free one, or, when an obstacle blocks the way toward the goal, classifies
+the obstacle by which sensors are active and runs the matching pre-planned manoeuvre without
+looking at goal costs at all (which is why obstacles *reduce* EPBHA's cost evaluations, Fig. 8.6):
+
+- single-sided (only the front sensor active): go around sideways, toward the goal's side;
+- partition, Π or Γ (front plus a lateral sensor active): pass over it;
+- one-side-open box or cave (the overhead sensor active too): back off diagonally, then pass
+  over its lid;
+- nothing free at all: hover and report a deadlock (the thesis admits this case, §8.6).
+
+The goal is split into the XY-plane goal (searched at the current altitude) and then the
+YZ-plane goal (Definition 1, Algorithms 8.5.1/8.5.2).
+
+Where this code departs from the text, and why:
+
+- Definition 2 writes the cost as A·(x1 − x2) + B·(y1 − y2), the difference between the current
+  and the next position; that is the same for every neighbour and signed. What it means is the
+  weighted Manhattan distance from the candidate coordinate to the plane's goal,
+  A·|a − a_goal| + B·|b − b_goal|, where A ≠ B makes the vehicle finish one axis before the
+  other instead of zig-zagging diagonally.
+- Algorithm 3 (grid making) loops i = 1 … 4 but fills "x ± d" and "y ± d" in one row, which
+  would make diagonal neighbours; the four neighbours are the ±d moves along each plane axis.
+- Algorithm 4 (heading) compares signed differences (x0 − x1) > (y0 − y1), so a move toward −x
+  would be read as a y heading; the heading axis is the one with the larger |displacement|.
+- Algorithm 5 (movement option) counts sensors reading beyond range but calls them "activated"
+  and computes 6 − count inside the loop; the text says the options are the sensors that see
+  nothing, which is what `Decision.movement_options` holds.
+- Algorithm 6 (next set position) compares y1 with y2, the unknown next position; it means the
+  goal's lateral coordinate: step sideways toward the goal's side, and when the goal is dead
+  ahead, toward the side whose sensor sees farther.
+- Obstacle classes count active sensors including up and down; a floor within 0.5 m is always
+  "active" when flying low and does not stop a vehicle passing over, so the class uses the
+  overhead sensor only (a lid or table top above makes a cave).
+- Diagonal back-off: a true diagonal step passes between two sensor cones, where nothing is
+  seen; the back-off is a staircase of axis steps (back, side, back, …), each along a cone axis.
+- The "no detection range offset" of Subfunction 2 is `keep_off_m`: a move is taken only when
+  its sensor sees nothing nearer than step + keep_off, and anything nearer than keep_off on
+  any side is first backed away from. Manoeuvres continue `edge_margin_steps` beyond the step
+  where an edge leaves the sensor cone, because a 22.5° half-cone stops seeing an edge before
+  the body has cleared it.
+- The thesis keeps no memory; a purely reactive rule can cycle forever (re-entering a cave it
+  just left). The planner counts visits per grid cell and reports a deadlock (loop) instead of
+  cycling, and after a cave it climbs above the lid height it measured before moving on.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planners.geometry import Vec3, World
+from planners.kinematic import KinematicParams, KinematicSim
+from planners.proximity import ProximityParams, ProximityReading
+from planners.result import PlanResult, PlanStatus
+
+
+class Move(enum.Enum):
+    """The six grid moves, as unit vectors in local NED."""
+
+    NORTH = (1, 0, 0)
+    SOUTH = (-1, 0, 0)
+    EAST = (0, 1, 0)
+    WEST = (0, -1, 0)
+    DOWN = (0, 0, 1)
+    UP = (0, 0, -1)
+
+    @property
+    def axis(self) -> int:
+        """Index of the NED axis the move is along."""
+        return next(i for i, c in enumerate(self.value) if c != 0)
+
+    @property
+    def sign(self) -> int:
+        """+1 or -1 along the move's axis."""
+        return self.value[self.axis]
+
+    @property
+    def opposite(self) -> Move:
+        """The move back."""
+        return _OPPOSITE[self]
+
+    def vec(self) -> Vec3:
+        """The unit vector as floats."""
+        return (float(self.value[0]), float(self.value[1]), float(self.value[2]))
+
+
+_OPPOSITE = {
+    Move.NORTH: Move.SOUTH,
+    Move.SOUTH: Move.NORTH,
+    Move.EAST: Move.WEST,
+    Move.WEST: Move.EAST,
+    Move.DOWN: Move.UP,
+    Move.UP: Move.DOWN,
+}
+_AXIS_MOVES = {0: (Move.NORTH, Move.SOUTH), 1: (Move.EAST, Move.WEST), 2: (Move.DOWN, Move.UP)}
+
+
+class Plane(enum.Enum):
+    """The plane searched: first the XY-plane goal, then the YZ-plane goal (Definition 1)."""
+
+    XY = (0, 1, 2)  # (axis weighted A, axis weighted B, out-of-plane axis)
+    YZ = (1, 2, 0)
+
+
+class Status(enum.Enum):
+    """What the planner tells the vehicle to do."""
+
+    MOVING = "moving"
+    REACHED = "reached"
+    DEADLOCK = "deadlock"
+
+
+class ObstacleClass(enum.Enum):
+    """Obstacle types EPBHA tells apart by its active sensors (§8.5, §9.3)."""
+
+    NONE = "none"
+    SINGLE_SIDED = "single-sided"
+    PARTITION = "partition"
+    CAVE = "cave"
+
+
+class Reason(enum.Enum):
+    """Why the planner chose this set position."""
+
+    COST = "minimum cost neighbour"
+    KEEP_OFF = "keep off a near obstacle"
+    GO_AROUND = "go around a single-sided obstacle"
+    PASS_ALONG = "pass alongside the obstacle"
+    PASS_OVER = "pass over a partition"
+    BACK_OFF = "back off diagonally from a cave"
+    REACHED = "goal reached"
+    DEADLOCK_BLOCKED = "deadlock: no free move"
+    DEADLOCK_LOOP = "deadlock: revisiting the same cells"
+
+
+@dataclass(frozen=True, slots=True)
+class EpbhaParams:
+    """EPBHA tuning; thesis values where the thesis gives one (sensors §8.6)."""
+
+    step_m: float = 0.1  # grid step d (the thesis leaves it to calibration)
+    weight_a: float = 4.0  # A of Definition 2, on the plane's first axis (x in XY, y in YZ)
+    weight_b: float = 2.0  # B of Definition 2, on the plane's second axis
+    sensor_range_m: float = 0.5  # §8.6
+    sensor_cone_deg: float = 45.0  # §8.6, full cone angle
+    keep_off_m: float = 0.2  # Subfunction 2's offset: >= body radius 0.15 m plus 5 cm
+    edge_margin_steps: int = 2  # extra steps once an edge leaves the cone (ceil(0.15 / 0.1))
+    max_visits: int = 4  # visits of one cell after which the planner reports a loop
+
+    def __post_init__(self) -> None:
+        if not self.step_m > 0.0:
+            raise ValueError(f"EPBHA step_m must be > 0, got {self.step_m}")
+        if not (self.weight_a > 0.0 and self.weight_b > 0.0):
+            raise ValueError("EPBHA weights A and B must be > 0")
+        if not self.sensor_range_m > 0.0 or self.keep_off_m < 0.0:
+            raise ValueError("EPBHA sensor_range_m must be > 0 and keep_off_m >= 0")
+        if self.step_m + self.keep_off_m >= self.sensor_range_m:
+            raise ValueError(
+                f"EPBHA step_m + keep_off_m ({self.step_m + self.keep_off_m} m) must be below "
+                f"the sensor range ({self.sensor_range_m} m), or a blocked move is never seen"
+            )
+        if self.edge_margin_steps < 0 or self.max_visits < 1:
+            raise ValueError("EPBHA edge_margin_steps must be >= 0 and max_visits >= 1")
+
+    @property
+    def blocked_below_m(self) -> float:
+        """A move is blocked when its sensor sees something nearer than this."""
+        return self.step_m + self.keep_off_m
+
+
+@dataclass(frozen=True, slots=True)
+class CostEntry:
+    """One row of the cost table: a candidate neighbour and its cost (Definition 2)."""
+
+    move: Move
+    pos_n: Vec3
+    cost: float
+    free: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """One EPBHA step: the next set position and why."""
+
+    next_pos_n: Vec3
+    status: Status
+    reason: Reason
+    obstacle: ObstacleClass
+    plane: Plane
+    heading: Move | None
+    costs: tuple[CostEntry, ...]
+    cost_evaluations: int  # entries computed this step (0 during a manoeuvre)
+    movement_options: int  # sensors that see nothing (Subfunction 3)
+
+
+@dataclass(slots=True)
+class _Manoeuvre:
+    kind: ObstacleClass
+    heading: Move  # the blocked direction toward the goal
+    side: Move  # lateral side to go around or back off toward
+    over: Move  # the bypass direction (up in the XY plane)
+    stage: int = 0
+    clear_steps: int = 0
+    back_next: bool = True
+    lid_z_m: float | None = None  # NED z of a cave's lid underside, when one was measured
+
+
+@dataclass
+class Epbha:
+    """Online EPBHA planner: feed it the vehicle's position and reading each step."""
+
+    params: EpbhaParams
+    goal_n: Vec3
+    start_n: Vec3
+    plane: Plane = Plane.XY
+    heading: Move | None = None
+    cost_evaluations: int = 0
+    _prev_n: Vec3 | None = None
+    _manoeuvre: _Manoeuvre | None = None
+    _visits: Counter[tuple[int, int, int]] = field(default_factory=Counter)
+    _deadlocked: bool = False
+
+    def __post_init__(self) -> None:
+        self.goal_n = tuple(float(c) for c in self.goal_n)  # type: ignore[assignment]
+        self.start_n = tuple(float(c) for c in self.start_n)  # type: ignore[assignment]
+
+    # --- grid -------------------------------------------------------------------------
+
+    def _snap(self, pos_n: Vec3) -> Vec3:
+        """The grid node (anchored at the start) nearest a measured position."""
+        d = self.params.step_m
+        return tuple(  # type: ignore[return-value]
+            s + round((p - s) / d) * d for p, s in zip(pos_n, self.start_n, strict=True)
+        )
+
+    def _key(self, pos_n: Vec3) -> tuple[int, int, int]:
+        d = self.params.step_m
+        return tuple(  # type: ignore[return-value]
+            round((p - s) / d) for p, s in zip(pos_n, self.start_n, strict=True)
+        )
+
+    def _neighbour(self, pos_n: Vec3, move: Move) -> Vec3:
+        d = self.params.step_m
+        return (pos_n[0] + move.value[0] * d, pos_n[1] + move.value[1] * d,
+                pos_n[2] + move.value[2] * d)
+
+    def _aligned(self, pos_n: Vec3, axis: int) -> bool:
+        return abs(pos_n[axis] - self.goal_n[axis]) <= self.params.step_m / 2.0 + 1e-9
+
+    # --- Definition 2 and the subfunctions ----------------------------------------------
+
+    def cost(self, pos_n: Vec3) -> float:
+        """Definition 2 (as meant): weighted Manhattan distance to the current plane's goal."""
+        a, b, _ = self.plane.value
+        return self.params.weight_a * abs(pos_n[a] - self.goal_n[a]) + self.params.weight_b * abs(
+            pos_n[b] - self.goal_n[b]
+        )
+
+    def grid_moves(self) -> tuple[Move, ...]:
+        """Algorithm 3 (grid making): the four in-plane neighbour moves."""
+        a, b, _ = self.plane.value
+        return (*_AXIS_MOVES[a], *_AXIS_MOVES[b])
+
+    @staticmethod
+    def heading_of(prev_n: Vec3, pos_n: Vec3) -> Move | None:
+        """Subfunction 1: the axis (and sense) of the last displacement, None if none."""
+        delta = [p - q for p, q in zip(pos_n, prev_n, strict=True)]
+        axis = max(range(3), key=lambda i: abs(delta[i]))
+        if abs(delta[axis]) < 1e-9:
+            return None
+        plus, minus = _AXIS_MOVES[axis]
+        return plus if delta[axis] > 0 else minus
+
+    def movement_options(self, reading: ProximityReading) -> int:
+        """Subfunction 3: the number of sensors that see nothing within range."""
+        return 6 - len(reading.active(self.params.sensor_range_m))
+
+    def lateral_toward_goal(self, pos_n: Vec3, heading: Move, reading: ProximityReading) -> Move:
+        """Subfunction 4: the sideways move (in plane, across `heading`) toward the goal's side."""
+        a, b, _ = self.plane.value
+        lateral_axis = b if heading.axis == a else a
+        plus, minus = _AXIS_MOVES[lateral_axis]
+        offset = self.goal_n[lateral_axis] - pos_n[lateral_axis]
+        if abs(offset) > self.params.step_m / 2.0:
+            return plus if offset > 0 else minus
+        # Goal dead ahead: take the side that sees farther (nothing seen counts as farthest).
+        sp, sm = reading.along_n(plus.vec()), reading.along_n(minus.vec())
+        return minus if (sm is None and sp is not None) or (
+            sm is not None and sp is not None and sm > sp
+        ) else plus
+
+    def _over_move(self, reading: ProximityReading) -> Move:
+        _, _, out = self.plane.value
+        if out == 2:
+            return Move.UP  # in the XY plane, passing over is climbing
+        plus, minus = _AXIS_MOVES[out]
+        sp, sm = reading.along_n(plus.vec()), reading.along_n(minus.vec())
+        return minus if (sm is None and sp is not None) or (
+            sm is not None and sp is not None and sm > sp
+        ) else plus
+
+    def _free(self, reading: ProximityReading, move: Move) -> bool:
+        seen = reading.along_n(move.vec())
+        return seen is None or seen >= self.params.blocked_below_m
+
+    def _active(self, reading: ProximityReading, move: Move) -> bool:
+        seen = reading.along_n(move.vec())
+        return seen is not None and seen <= self.params.sensor_range_m
+
+    def classify(self, reading: ProximityReading, heading: Move) -> ObstacleClass:
+        """The obstacle class seen when `heading` is blocked (see the module docstring)."""
+        over = self._over_move(reading)
+        if self._active(reading, over):
+            return ObstacleClass.CAVE
+        a, b, _ = self.plane.value
+        lateral_axis = b if heading.axis == a else a
+        # A lateral cone sees the blocking obstacle itself obliquely no nearer than
+        # front / sin(half cone); only a nearer return is a second obstacle (a wing).
+        front = reading.along_n(heading.vec())
+        oblique_m = math.inf
+        if front is not None:
+            oblique_m = 0.9 * front / math.sin(math.radians(self.params.sensor_cone_deg) / 2.0)
+        for move in _AXIS_MOVES[lateral_axis]:
+            seen = reading.along_n(move.vec())
+            if seen is not None and seen <= self.params.sensor_range_m and seen < oblique_m:
+                return ObstacleClass.PARTITION
+        return ObstacleClass.SINGLE_SIDED
+
+    # --- the step ---------------------------------------------------------------------
+
+    def step(self, pos_n: Vec3, reading: ProximityReading) -> Decision:
+        """One planning step from the measured position and the six sensor readings."""
+        pos = self._snap(tuple(float(c) for c in pos_n))  # type: ignore[arg-type]
+        if self._prev_n is not None:
+            self.heading = self.heading_of(self._prev_n, pos) or self.heading
+        self._prev_n = pos
+        options = self.movement_options(reading)
+
+        if self.plane is Plane.XY and self._aligned(pos, 0) and self._aligned(pos, 1):
+            self.plane, self._manoeuvre = Plane.YZ, None
+        if self.plane is Plane.YZ and all(self._aligned(pos, i) for i in range(3)):
+            return self._decide(pos, Status.REACHED, Reason.REACHED, ObstacleClass.NONE,
+                                (), options)
+        if self.plane is Plane.YZ and self._manoeuvre is None and not self._aligned(pos, 0):
+            # An out-of-plane bypass in the YZ plane moved x: the XY goal applies again.
+            self.plane = Plane.XY
+
+        if self._deadlocked:
+            return self._hover(pos, Reason.DEADLOCK_LOOP, options)
+        key = self._key(pos)
+        self._visits[key] += 1
+        if self._visits[key] > self.params.max_visits:
+            self._deadlocked = True
+            return self._hover(pos, Reason.DEADLOCK_LOOP, options)
+
+        if self._manoeuvre is not None:
+            decision = self._continue_manoeuvre(pos, reading, options)
+            if decision is not None:
+                return decision
+
+        keep_off = self._keep_off(reading)
+        if keep_off is not None:
+            return self._decide(self._neighbour(pos, keep_off), Status.MOVING, Reason.KEEP_OFF,
+                                ObstacleClass.NONE, (), options)
+
+        table = tuple(
+            CostEntry(m, n, self.cost(n), self._free(reading, m))
+            for m in self.grid_moves()
+            for n in (self._neighbour(pos, m),)
+        )
+        self.cost_evaluations += len(table)
+        here = self.cost(pos)
+        improving = sorted((e for e in table if e.cost < here - 1e-9), key=lambda e: e.cost)
+        for entry in improving:
+            if entry.free:
+                return self._decide(entry.pos_n, Status.MOVING, Reason.COST, ObstacleClass.NONE,
+                                    table, options)
+        if not improving:
+            # The plane goal is reached up to the grid: nothing cheaper is left.
+            return self._decide(pos, Status.MOVING, Reason.COST, ObstacleClass.NONE, table,
+                                options)
+        blocked = improving[0].move
+        return self._start_manoeuvre(pos, reading, blocked, table, options)
+
+    # --- manoeuvres -------------------------------------------------------------------
+
+    def _keep_off(self, reading: ProximityReading) -> Move | None:
+        """The move away from anything nearer than keep_off, if that way is free."""
+        nearest: tuple[float, Move] | None = None
+        for move in Move:
+            seen = reading.along_n(move.vec())
+            if seen is not None and seen < self.params.keep_off_m - 1e-9 and (
+                nearest is None or seen < nearest[0]
+            ):
+                nearest = (seen, move)
+        if nearest is None:
+            return None
+        away = nearest[1].opposite
+        return away if self._free(reading, away) else None
+
+    def _start_manoeuvre(
+        self,
+        pos: Vec3,
+        reading: ProximityReading,
+        heading: Move,
+        table: tuple[CostEntry, ...],
+        options: int,
+    ) -> Decision:
+        kind = self.classify(reading, heading)
+        side = self.lateral_toward_goal(pos, heading, reading)
+        over = self._over_move(reading)
+        man = _Manoeuvre(kind, heading, side, over)
+        if kind is ObstacleClass.CAVE:
+            seen_up = reading.along_n(over.vec())
+            if over is Move.UP and seen_up is not None:
+                man.lid_z_m = pos[2] - seen_up
+            if not self._free(reading, side):
+                man.side = side.opposite
+        self._manoeuvre = man
+        decision = self._continue_manoeuvre(pos, reading, options, table)
+        if decision is None:
+            return self._hover(pos, Reason.DEADLOCK_BLOCKED, options, kind, table)
+        return decision
+
+    def _continue_manoeuvre(
+        self,
+        pos: Vec3,
+        reading: ProximityReading,
+        options: int,
+        table: tuple[CostEntry, ...] = (),
+    ) -> Decision | None:
+        """The manoeuvre's next move, None when it has finished; hovers when stuck."""
+        man = self._manoeuvre
+        assert man is not None
+        margin = self.params.edge_margin_steps
+
+        def go(move: Move, reason: Reason) -> Decision:
+            return self._decide(self._neighbour(pos, move), Status.MOVING, reason, man.kind,
+                                table, options)
+
+        if man.kind is ObstacleClass.SINGLE_SIDED:
+            if man.stage == 0:
+                man.clear_steps = 0 if self._active(reading, man.heading) else man.clear_steps + 1
+                if man.clear_steps <= margin:
+                    if self._free(reading, man.side):
+                        return go(man.side, Reason.GO_AROUND)
+                    # The way around is closed too: it is a partition after all.
+                    man.kind, man.stage, man.clear_steps = ObstacleClass.PARTITION, 0, 0
+                    return self._continue_manoeuvre(pos, reading, options, table)
+                man.stage, man.clear_steps = 1, 0
+            if man.stage == 1:
+                beside = man.side.opposite
+                man.clear_steps = 0 if self._active(reading, beside) else man.clear_steps + 1
+                heading_improves = not self._aligned(pos, man.heading.axis)
+                if man.clear_steps <= margin and heading_improves and self._free(
+                    reading, man.heading
+                ):
+                    return go(man.heading, Reason.PASS_ALONG)
+            self._manoeuvre = None
+            return None
+
+        if man.kind is ObstacleClass.PARTITION:
+            above_lid = man.lid_z_m is None or pos[2] < man.lid_z_m - self.params.keep_off_m
+            front_seen = self._active(reading, man.heading)
+            man.clear_steps = 0 if (front_seen or not above_lid) else man.clear_steps + 1
+            if man.clear_steps <= margin:
+                if self._free(reading, man.over):
+                    return go(man.over, Reason.PASS_OVER)
+                # Cannot pass over: go around on a free side, else it is a box to back out of.
+                for side in (man.side, man.side.opposite):
+                    if self._free(reading, side) and man.stage == 0:
+                        man.kind, man.side, man.stage, man.clear_steps = (
+                            ObstacleClass.SINGLE_SIDED, side, 0, 0)
+                        return go(side, Reason.GO_AROUND)
+                man.kind, man.stage, man.clear_steps = ObstacleClass.CAVE, 1, 0
+                return self._continue_manoeuvre(pos, reading, options, table)
+            self._manoeuvre = None
+            return None
+
+        # CAVE: staircase back and sideways until the overhead sensor is clear, then climb.
+        if not self._active(reading, man.over):
+            man.kind, man.stage, man.clear_steps = ObstacleClass.PARTITION, 1, 0
+            return self._continue_manoeuvre(pos, reading, options, table)
+        back = man.heading.opposite
+        order = (back, man.side) if man.back_next else (man.side, back)
+        for move in order:
+            if self._free(reading, move):
+                man.back_next = move is not back
+                return go(move, Reason.BACK_OFF)
+        if self._free(reading, man.side.opposite):
+            man.side = man.side.opposite
+            man.back_next = True
+            return go(man.side, Reason.BACK_OFF)
+        self._manoeuvre = None
+        return self._hover(pos, Reason.DEADLOCK_BLOCKED, options, ObstacleClass.CAVE, table)
+
+    # --- decisions --------------------------------------------------------------------
+
+    def _decide(
+        self,
+        next_pos: Vec3,
+        status: Status,
+        reason: Reason,
+        obstacle: ObstacleClass,
+        table: tuple[CostEntry, ...],
+        options: int,
+    ) -> Decision:
+        return Decision(next_pos, status, reason, obstacle, self.plane, self.heading, table,
+                        len(table) if reason is Reason.COST else 0, options)
+
+    def _hover(
+        self,
+        pos: Vec3,
+        reason: Reason,
+        options: int,
+        obstacle: ObstacleClass = ObstacleClass.NONE,
+        table: tuple[CostEntry, ...] = (),
+    ) -> Decision:
+        return Decision(pos, Status.DEADLOCK, reason, obstacle, self.plane, self.heading, table,
+                        0, options)
+
+
+def run_epbha(
+    world: World,
+    start_n: Vec3,
+    goal_n: Vec3,
+    params: EpbhaParams | None = None,
+    max_steps: int = 2000,
+    kinematic: KinematicParams | None = None,
+    proximity: ProximityParams | None = None,
+    rng: np.random.Generator | None = None,
+    cpu_clock: Callable[[], float] = time.process_time,
+) -> PlanResult:
+    """Fly EPBHA in the kinematic world from `start_n` toward `goal_n`."""
+    params = params or EpbhaParams()
+    proximity = proximity or ProximityParams(range_m=params.sensor_range_m)
+    sim = KinematicSim(world, start_n, kinematic or KinematicParams(), proximity, rng)
+    planner = Epbha(params, goal_n, start_n)
+    cpu: list[float] = []
+    status, detail = PlanStatus.MAX_STEPS, f"no goal after {max_steps} steps"
+    for _ in range(max_steps + 1):
+        reading = sim.sense()
+        t0 = cpu_clock()
+        decision = planner.step(sim.pos_n, reading)
+        cpu.append(cpu_clock() - t0)
+        if decision.status is Status.REACHED:
+            status, detail = PlanStatus.REACHED, ""
+            break
+        if decision.status is Status.DEADLOCK:
+            status, detail = PlanStatus.DEADLOCK, decision.reason.value
+            break
+        if len(sim.path) > max_steps:
+            break
+        sim.move_to(decision.next_pos_n)
+    return PlanResult(
+        planner="EPBHA",
+        status=status,
+        path=tuple(sim.path),
+        cost_evaluations=planner.cost_evaluations,
+        node_expansions=0,
+        cpu_s_per_step=tuple(cpu),
+        min_clearance_m=sim.min_clearance_m if math.isfinite(sim.min_clearance_m) else 0.0,
+        collisions=sim.collisions,
+        detail=detail,
+    )

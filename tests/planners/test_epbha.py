@@ -1,0 +1,157 @@
+"""EPBHA: subfunctions, obstacle classes and the thesis's scenes in the kinematic world."""
+
+import math
+
+import pytest
+
+from planners.epbha import (
+    Epbha,
+    EpbhaParams,
+    Move,
+    ObstacleClass,
+    Plane,
+    Reason,
+    Status,
+    run_epbha,
+)
+from planners.proximity import Facing, ProximityReading
+from planners.result import PlanStatus
+from planners.scenes import Scene, thesis_scenes
+
+START = (0.0, 0.0, -1.0)
+
+
+def reading(**facings: float) -> ProximityReading:
+    return ProximityReading.from_facings({Facing[k.upper()]: v for k, v in facings.items()})
+
+
+def planner(goal: tuple[float, float, float] = (2.0, 0.0, -1.0)) -> Epbha:
+    return Epbha(EpbhaParams(), goal, START)
+
+
+def test_params_reject_a_blocked_distance_beyond_sensor_range() -> None:
+    with pytest.raises(ValueError, match="sensor range"):
+        EpbhaParams(step_m=0.2, keep_off_m=0.35)
+
+
+def test_cost_is_weighted_manhattan_distance_to_plane_goal() -> None:
+    p = planner((1.0, 0.5, -0.2))
+    assert p.cost((0.0, 0.0, -1.0)) == pytest.approx(4.0 * 1.0 + 2.0 * 0.5)
+    p.plane = Plane.YZ
+    assert p.cost((0.0, 0.0, -1.0)) == pytest.approx(4.0 * 0.5 + 2.0 * 0.8)
+
+
+def test_grid_making_gives_four_in_plane_neighbours() -> None:
+    p = planner()
+    assert set(p.grid_moves()) == {Move.NORTH, Move.SOUTH, Move.EAST, Move.WEST}
+    p.plane = Plane.YZ
+    assert set(p.grid_moves()) == {Move.EAST, Move.WEST, Move.DOWN, Move.UP}
+
+
+def test_heading_uses_the_larger_absolute_displacement() -> None:
+    # The thesis's signed comparison would call a southward move a y heading.
+    assert Epbha.heading_of((1.0, 0.0, 0.0), (0.9, 0.02, 0.0)) is Move.SOUTH
+    assert Epbha.heading_of((0.0, 0.0, 0.0), (0.0, -0.1, 0.0)) is Move.WEST
+    assert Epbha.heading_of((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)) is None
+
+
+def test_sensor_values_reorient_with_yaw() -> None:
+    # Facing east, the sensor seeing north is the left one.
+    r = ProximityReading.from_facings({Facing.LEFT: 0.2}, yaw_rad=math.pi / 2)
+    assert r.along_n(Move.NORTH.vec()) == 0.2
+    assert r.along_n(Move.EAST.vec()) is None
+
+
+def test_movement_options_count_sensors_that_see_nothing() -> None:
+    assert planner().movement_options(reading(front=0.3, up=0.45, down=0.6)) == 4
+
+
+def test_next_set_position_steps_toward_the_goal_side() -> None:
+    p = planner((2.0, -1.0, -1.0))
+    assert p.lateral_toward_goal(START, Move.NORTH, ProximityReading.clear()) is Move.WEST
+    p = planner((2.0, 0.0, -1.0))
+    # Goal dead ahead: the side that sees farther.
+    assert p.lateral_toward_goal(START, Move.NORTH, reading(right=0.4)) is Move.WEST
+    assert p.lateral_toward_goal(START, Move.NORTH, reading(left=0.3, right=0.45)) is Move.EAST
+
+
+def test_free_space_moves_to_minimum_cost_with_four_evaluations() -> None:
+    p = planner((1.0, 1.0, -1.0))
+    d = p.step(START, ProximityReading.clear())
+    assert d.status is Status.MOVING and d.reason is Reason.COST
+    assert d.next_pos_n == pytest.approx((0.1, 0.0, -1.0))  # A > B: forward before sideways
+    assert d.cost_evaluations == 4 and len(d.costs) == 4
+    assert min(d.costs, key=lambda e: e.cost).move is Move.NORTH
+
+
+def test_single_sided_obstacle_goes_around_without_cost_evaluations() -> None:
+    p = planner((2.0, 0.0, -1.0))
+    d = p.step(START, reading(front=0.25))
+    assert d.obstacle is ObstacleClass.SINGLE_SIDED and d.reason is Reason.GO_AROUND
+    assert d.next_pos_n == pytest.approx((0.0, 0.1, -1.0))  # goal dead ahead: the open side
+    d2 = p.step(d.next_pos_n, reading(front=0.26))
+    assert d2.reason is Reason.GO_AROUND and d2.cost_evaluations == 0
+
+
+def test_partition_is_passed_over() -> None:
+    p = planner()
+    d = p.step(START, reading(front=0.25, right=0.35))
+    assert d.obstacle is ObstacleClass.PARTITION and d.reason is Reason.PASS_OVER
+    assert d.next_pos_n == pytest.approx((0.0, 0.0, -1.1))  # up is -z
+
+
+def test_lateral_view_of_the_same_wall_is_not_a_partition() -> None:
+    # A wall 0.2 m ahead shows in a side cone no nearer than 0.2 / sin(22.5°) = 0.52 m.
+    p = planner()
+    d = p.step(START, reading(front=0.2, right=0.49))
+    assert d.obstacle is ObstacleClass.SINGLE_SIDED
+
+
+def test_cave_backs_off_diagonally_as_a_staircase() -> None:
+    p = planner()
+    d1 = p.step(START, reading(front=0.25, up=0.3))
+    assert d1.obstacle is ObstacleClass.CAVE and d1.reason is Reason.BACK_OFF
+    assert d1.next_pos_n == pytest.approx((-0.1, 0.0, -1.0))
+    d2 = p.step(d1.next_pos_n, reading(up=0.3))
+    assert d2.reason is Reason.BACK_OFF
+    assert d2.next_pos_n == pytest.approx((-0.1, 0.1, -1.0))  # then sideways
+
+
+def test_cave_with_everything_closed_is_a_deadlock_and_hovers() -> None:
+    p = planner()
+    d = p.step(START, reading(front=0.25, back=0.25, left=0.25, right=0.25, up=0.3))
+    assert d.status is Status.DEADLOCK and d.reason is Reason.DEADLOCK_BLOCKED
+    assert d.next_pos_n == pytest.approx(START)
+
+
+def test_keep_off_backs_away_from_a_near_obstacle() -> None:
+    d = planner().step(START, reading(up=0.1))
+    assert d.reason is Reason.KEEP_OFF
+    assert d.next_pos_n == pytest.approx((0.0, 0.0, -0.9))
+
+
+def test_xy_goal_then_yz_goal_then_reached() -> None:
+    p = planner((0.0, 0.0, -0.8))
+    d = p.step(START, ProximityReading.clear())
+    assert d.plane is Plane.YZ and d.next_pos_n == pytest.approx((0.0, 0.0, -0.9))
+    d = p.step(d.next_pos_n, ProximityReading.clear())
+    d = p.step(d.next_pos_n, ProximityReading.clear())
+    assert d.status is Status.REACHED and d.next_pos_n == pytest.approx((0.0, 0.0, -0.8))
+
+
+def test_revisiting_a_cell_too_often_is_a_loop_deadlock() -> None:
+    p = Epbha(EpbhaParams(max_visits=2), (2.0, 0.0, -1.0), START)
+    for _ in range(2):
+        assert p.step(START, reading(up=0.1, down=0.1)).status is Status.MOVING
+    d = p.step(START, reading(up=0.1, down=0.1))
+    assert d.status is Status.DEADLOCK and d.reason is Reason.DEADLOCK_LOOP
+
+
+@pytest.mark.parametrize("scene", thesis_scenes(), ids=lambda s: s.name)
+def test_thesis_scenes_are_reached_without_collisions(scene: Scene) -> None:
+    r = run_epbha(scene.world, scene.start_n, scene.goal_n, max_steps=1500)
+    assert r.status is PlanStatus.REACHED, r.detail
+    assert r.collisions == 0 and r.min_clearance_m >= 0.15
+    assert math.dist(r.path[-1], scene.goal_n) <= 0.1
+    assert r.cost_evaluations <= 4 * r.steps
+    assert len(r.cpu_s_per_step) == r.steps + 1
