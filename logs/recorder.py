@@ -187,9 +187,8 @@ class Recorder:
             **dict(metadata),
         }
         self._sink.write_metadata(METADATA_NAME, encode_metadata(header))
-        first_ns = self._anchor_ns + time.monotonic_ns()
-        self._write_foxglove(TF_TOPIC, first_ns, ned_display_transform())
         self._sink.flush()
+        self._display_tf_written = False
         self._thread = threading.Thread(
             target=self._run, name=f"recorder-{vehicle}", daemon=True
         )
@@ -315,6 +314,11 @@ class Recorder:
                 self._sink.write_metadata(topic, encode_metadata(payload))
                 return
             log_ns = self._anchor_ns + round(t_s * 1e9)
+            if not self._display_tf_written:
+                # once, at the first message's time, so it spans the flight's timeline
+                self._write_foxglove(TF_TOPIC, log_ns, ned_display_transform())
+                self._written[TF_TOPIC] = 1
+                self._display_tf_written = True
             if kind is _Kind.RAW:
                 if not self._sink.has_topic(topic):
                     self._sink.add_topic(topic, RAW_FRAME_SCHEMA_NAME, RAW_FRAME_SCHEMA)
