@@ -1,1 +1,49 @@
 """The bundled simulated vehicle: physics, ArduCopter-like autopilot, sensors, MAVLink endpoints."""
+
+from sitl.battery import BatteryState
+from sitl.params import ParamError, VehicleParams
+from sitl.physics import PhysicsState
+from sitl.sensor_params import SensorParams
+from sitl.sensors import (
+    BaroSample,
+    ImuSample,
+    MocapSample,
+    ProximityFacing,
+    ProximitySample,
+    SonarSample,
+)
+from sitl.vehicle_model import SimVehicle, TruthState
+from sitl.world import (
+    Box,
+    FloorMaterial,
+    FloorPatch,
+    RadiationSource,
+    World,
+    WorldError,
+    default_world,
+    load_world,
+)
+
+__all__ = [
+    "BaroSample",
+    "BatteryState",
+    "Box",
+    "FloorMaterial",
+    "FloorPatch",
+    "ImuSample",
+    "MocapSample",
+    "ParamError",
+    "PhysicsState",
+    "ProximityFacing",
+    "ProximitySample",
+    "RadiationSource",
+    "SensorParams",
+    "SimVehicle",
+    "SonarSample",
+    "TruthState",
+    "VehicleParams",
+    "World",
+    "WorldError",
+    "default_world",
+    "load_world",
+]

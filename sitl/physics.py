@@ -1,0 +1,322 @@
+"""6-DOF rigid-body quadrotor in the thesis's "+" configuration, with motors, battery and contact.
+
+Motor order is (front, right, back, left). Front and back spin clockwise seen from above, right
+and left counter-clockwise (thesis Ch. 3). Body frame FRD, world frame local NED, q_nb = (w,x,y,z).
+
+Forces and torques, and where they depart from the thesis's equations:
+- Thrust (eq. 3.3): T = T_f + T_r + T_b + T_l along body -z; T_i = k_t·ω_i².
+- Roll torque: eq. 3.4 repeats eq. 3.3. With arm length l, rotor thrust at r_i along -z gives
+  τ = r_i × F_i, so τ_x = l·(T_l − T_r): more thrust on the right rolls left (negative roll).
+- Pitch torque (eq. 3.5): τ_y = l·(T_f − T_b): more front thrust pitches nose up (positive).
+- Yaw torque: eq. 3.6 writes a sum of thrusts. It is the sum of the rotors' reaction torques
+  Q_i = k_m·ω_i². A rotor spinning clockwise seen from above has angular velocity along body +z
+  (down); the air's drag torque on it is countered by the motor, whose reaction on the frame is
+  along −z. So τ_z = k_m·(ω_r² + ω_l² − ω_f² − ω_b²): speeding up the clockwise pair yaws the
+  nose left (negative yaw rate).
+- Rotational dynamics: eq. 3.8 divides the torques by the mass. Euler's equation is
+  ω̇ = J⁻¹(τ − ω × Jω), J diagonal (see sitl.params for the inertia).
+- Translation: eq. 3.7 is written in the body frame; here Newton's law is integrated in NED,
+  m·a = R(q)·(0, 0, −T) + m·g·e_z − (c₁ + c₂·|v|)·v, which is the same physics.
+
+Integration is semi-implicit Euler at dt ≤ 2.5 ms: velocity first, then position with the new
+velocity; quaternion by q ← q ⊗ (1, ω·dt/2), renormalised every step.
+
+Contact: the floor (or a box top) supports the skids. A vehicle resting with thrust below weight
+keeps z, has zero vertical velocity and level attitude, and Coulomb friction stops sliding; a
+touchdown is perfectly inelastic (no bounce, no energy gained). Hitting a wall, the ceiling or a
+box with the body (a vertical cylinder of the arm-tip radius) stops the vehicle where it was
+and names the obstacle in `collided_with`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sitl.battery import cell_ocv_v
+from sitl.geometry import Geometry, geometry
+from sitl.motors import clamp_throttle
+from sitl.params import GRAVITY_MPS2, VehicleParams, derived
+from sitl.rotation import quat_from_euler, quat_to_euler
+from sitl.world import World
+
+G = GRAVITY_MPS2
+
+
+class Core:
+    """Mutable plain-float state the integrator updates in place (the hot path)."""
+
+    __slots__ = (
+        "ax",
+        "ay",
+        "az",
+        "collided_with",
+        "current_a",
+        "m0",
+        "m1",
+        "m2",
+        "m3",
+        "on_ground",
+        "p",
+        "q",
+        "qw",
+        "qx",
+        "qy",
+        "qz",
+        "r",
+        "used_mah",
+        "voltage_v",
+        "vx",
+        "vy",
+        "vz",
+        "x",
+        "y",
+        "z",
+    )
+
+    def __init__(self) -> None:
+        self.x = self.y = self.z = 0.0
+        self.vx = self.vy = self.vz = 0.0
+        self.ax = self.ay = self.az = 0.0
+        self.qw, self.qx, self.qy, self.qz = 1.0, 0.0, 0.0, 0.0
+        self.p = self.q = self.r = 0.0
+        self.m0 = self.m1 = self.m2 = self.m3 = 0.0
+        self.used_mah = 0.0
+        self.current_a = 0.0
+        self.voltage_v = 0.0
+        self.on_ground = False
+        self.collided_with: str | None = None
+
+
+def advance(
+    c: Core,
+    u0: float,
+    u1: float,
+    u2: float,
+    u3: float,
+    prm: VehicleParams,
+    geom: Geometry,
+    dt: float,
+) -> None:
+    """Advance `c` by one sub-step dt (≤ prm.max_dt_s) with throttles u (0..1, pre-clamped)."""
+    d = derived(prm)
+    # Motors: steady speed from throttle and battery volts, first-order lag (exact discrete).
+    wmax = d.omega_max_ref_radps * c.voltage_v / prm.ref_voltage_v
+    e = prm.thrust_expo
+    lin = 1.0 - e
+    alpha = 1.0 - math.exp(-dt / prm.motor_lag_s)
+    m0 = c.m0 + (wmax * math.sqrt(lin * u0 + e * u0 * u0) - c.m0) * alpha
+    m1 = c.m1 + (wmax * math.sqrt(lin * u1 + e * u1 * u1) - c.m1) * alpha
+    m2 = c.m2 + (wmax * math.sqrt(lin * u2 + e * u2 * u2) - c.m2) * alpha
+    m3 = c.m3 + (wmax * math.sqrt(lin * u3 + e * u3 * u3) - c.m3) * alpha
+    c.m0, c.m1, c.m2, c.m3 = m0, m1, m2, m3
+    s0, s1, s2, s3 = m0 * m0, m1 * m1, m2 * m2, m3 * m3
+    kt = d.k_thrust
+    thrust = kt * (s0 + s1 + s2 + s3)
+
+    # Battery: shaft power k_m·ω³ over efficiency, at the previous terminal voltage.
+    shaft_w = d.k_torque * (s0 * m0 + s1 * m1 + s2 * m2 + s3 * m3)
+    v_prev = c.voltage_v
+    current = prm.avionics_current_a + (
+        shaft_w / (prm.motor_efficiency * v_prev) if v_prev > 0.5 else 0.0
+    )
+    used = c.used_mah + current * dt / 3.6
+    soc = 1.0 - used / prm.battery_capacity_mah
+    ocv = prm.battery_cells * cell_ocv_v(soc)
+    c.used_mah = used
+    c.current_a = current
+    c.voltage_v = max(ocv - current * prm.battery_resistance_ohm, 0.0)
+
+    # Forces in NED.
+    qw, qx, qy, qz = c.qw, c.qx, c.qy, c.qz
+    bzx = 2.0 * (qx * qz + qw * qy)  # body +z axis expressed in NED
+    bzy = 2.0 * (qy * qz - qw * qx)
+    bzz = 1.0 - 2.0 * (qx * qx + qy * qy)
+    vx, vy, vz = c.vx, c.vy, c.vz
+    drag = prm.drag_lin_n_per_mps + prm.drag_quad_n_per_mps2 * math.sqrt(
+        vx * vx + vy * vy + vz * vz
+    )
+    im = d.inv_mass
+    ax = (-thrust * bzx - drag * vx) * im
+    ay = (-thrust * bzy - drag * vy) * im
+    az = (-thrust * bzz - drag * vz) * im + G
+
+    if c.on_ground and az >= 0.0:
+        # Resting on the support: the normal force cancels az; friction brakes any slide.
+        speed_h = math.sqrt(vx * vx + vy * vy)
+        nvx = nvy = 0.0
+        if speed_h > 0.0:
+            decel = prm.ground_friction * az * dt
+            keep = max(speed_h - decel, 0.0) / speed_h
+            nvx, nvy = vx * keep, vy * keep
+        c.x += nvx * dt
+        c.y += nvy * dt
+        c.ax, c.ay, c.az = (nvx - vx) / dt, (nvy - vy) / dt, -vz / dt
+        c.vx, c.vy, c.vz = nvx, nvy, 0.0
+        c.p = c.q = c.r = 0.0
+        c.collided_with = None
+        hit = geom.cylinder_hit(c.x, c.y, c.z, prm.body_radius_m, prm.body_half_height_m)
+        if hit is not None:
+            c.x -= nvx * dt
+            c.y -= nvy * dt
+            c.vx = c.vy = 0.0
+            c.collided_with = hit
+        return
+
+    # Torques in FRD (see module docstring for the signs).
+    arm = d.arm_m
+    crot = prm.rot_drag_nm_per_radps
+    p, q, r = c.p, c.q, c.r
+    tx = arm * kt * (s3 - s1) - crot * p
+    ty = arm * kt * (s0 - s2) - crot * q
+    tz = d.k_torque * (s1 + s3 - s0 - s2) - crot * r
+    ixx, iyy, izz = d.ixx, d.iyy, d.izz
+    p += (tx - q * r * (izz - iyy)) / ixx * dt
+    q += (ty - r * p * (ixx - izz)) / iyy * dt
+    r += (tz - p * q * (iyy - ixx)) / izz * dt
+    c.p, c.q, c.r = p, q, r
+    h = 0.5 * dt
+    nw = qw - h * (qx * p + qy * q + qz * r)
+    nx = qx + h * (qw * p + qy * r - qz * q)
+    ny = qy + h * (qw * q + qz * p - qx * r)
+    nz = qz + h * (qw * r + qx * q - qy * p)
+    inv = 1.0 / math.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+    c.qw, c.qx, c.qy, c.qz = nw * inv, nx * inv, ny * inv, nz * inv
+
+    nvx, nvy, nvz = vx + ax * dt, vy + ay * dt, vz + az * dt
+    ox, oy, oz = c.x, c.y, c.z
+    nx_, ny_, nz_ = ox + nvx * dt, oy + nvy * dt, oz + nvz * dt
+    rest_z = geom.support_z(nx_, ny_, oz) - prm.gear_height_m
+    on_ground = nz_ >= rest_z
+    if on_ground:
+        # Inelastic touchdown: stop on the surface, attitude settles level on the skids.
+        nz_ = rest_z
+        if nvz > 0.0:
+            nvz = 0.0
+        c.p = c.q = c.r = 0.0
+        yaw = math.atan2(2.0 * (c.qw * c.qz + c.qx * c.qy), 1.0 - 2.0 * (c.qy**2 + c.qz**2))
+        c.qw, c.qx, c.qy, c.qz = math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0)
+    hit = geom.cylinder_hit(nx_, ny_, nz_, prm.body_radius_m, prm.body_half_height_m)
+    if hit is not None and (
+        geom.cylinder_hit(ox, oy, oz, prm.body_radius_m, prm.body_half_height_m) is None
+    ):
+        # Stop where it was rather than tunnel into the obstacle.
+        nx_, ny_, nz_ = ox, oy, oz
+        nvx = nvy = nvz = 0.0
+        on_ground = c.on_ground
+    c.collided_with = hit
+    c.ax, c.ay, c.az = (nvx - vx) / dt, (nvy - vy) / dt, (nvz - vz) / dt
+    c.vx, c.vy, c.vz = nvx, nvy, nvz
+    c.x, c.y, c.z = nx_, ny_, nz_
+    c.on_ground = on_ground
+
+
+def run(
+    c: Core, motor_cmd: Sequence[float], prm: VehicleParams, geom: Geometry, dt_s: float
+) -> None:
+    """Advance `c` by dt_s in equal sub-steps no longer than prm.max_dt_s."""
+    if not (dt_s > 0.0 and math.isfinite(dt_s)):
+        raise ValueError(f"dt_s: expected a finite number > 0, got {dt_s!r}")
+    u = [clamp_throttle(v) for v in motor_cmd]
+    if len(u) != 4:
+        raise ValueError(
+            f"motor_cmd: expected 4 throttles (front, right, back, left), got {len(u)}"
+        )
+    n = max(1, math.ceil(dt_s / prm.max_dt_s - 1e-9))
+    h = dt_s / n
+    for _ in range(n):
+        advance(c, u[0], u[1], u[2], u[3], prm, geom, h)
+
+
+@dataclass(frozen=True)
+class PhysicsState:
+    """Rigid body + motors + battery, as numpy arrays (NED, FRD, q_nb = w, x, y, z)."""
+
+    pos_n: np.ndarray  # m
+    vel_n: np.ndarray  # m/s
+    acc_n: np.ndarray  # m/s², over the last step (what an ideal accelerometer integrates)
+    q_nb: np.ndarray  # unit quaternion, body to NED
+    omega_b: np.ndarray  # rad/s, body rates p, q, r
+    motor_speed_radps: np.ndarray  # (front, right, back, left)
+    used_mah: float = 0.0
+    current_a: float = 0.0
+    voltage_v: float = 0.0
+    on_ground: bool = False
+    collided_with: str | None = None
+
+    @staticmethod
+    def at_rest(
+        prm: VehicleParams, world: World, pos_n: Sequence[float], yaw_rad: float = 0.0
+    ) -> PhysicsState:
+        """Motors stopped, full battery, resting on the surface below pos_n (or in the air)."""
+        c = initial_core(prm, world, pos_n, yaw_rad)
+        return to_state(c)
+
+    def euler_rad(self) -> tuple[float, float, float]:
+        """(roll, pitch, yaw)."""
+        w, x, y, z = (float(v) for v in self.q_nb)
+        return quat_to_euler((w, x, y, z))
+
+
+def initial_core(
+    prm: VehicleParams, world: World, pos_n: Sequence[float], yaw_rad: float = 0.0
+) -> Core:
+    """A Core at pos_n; if pos_n is at or below the resting height it rests on the support."""
+    geom = geometry(world)
+    c = Core()
+    c.x, c.y, c.z = (float(v) for v in pos_n)
+    rest_z = geom.support_z(c.x, c.y, c.z) - prm.gear_height_m
+    if c.z >= rest_z:
+        c.z = rest_z
+        c.on_ground = True
+    c.qw, c.qx, c.qy, c.qz = quat_from_euler(0.0, 0.0, yaw_rad)
+    c.current_a = prm.avionics_current_a
+    c.voltage_v = prm.battery_cells * cell_ocv_v(1.0) - c.current_a * prm.battery_resistance_ohm
+    return c
+
+
+def to_state(c: Core) -> PhysicsState:
+    """Snapshot of a Core as a PhysicsState."""
+    return PhysicsState(
+        pos_n=np.array([c.x, c.y, c.z]),
+        vel_n=np.array([c.vx, c.vy, c.vz]),
+        acc_n=np.array([c.ax, c.ay, c.az]),
+        q_nb=np.array([c.qw, c.qx, c.qy, c.qz]),
+        omega_b=np.array([c.p, c.q, c.r]),
+        motor_speed_radps=np.array([c.m0, c.m1, c.m2, c.m3]),
+        used_mah=c.used_mah,
+        current_a=c.current_a,
+        voltage_v=c.voltage_v,
+        on_ground=c.on_ground,
+        collided_with=c.collided_with,
+    )
+
+
+def from_state(s: PhysicsState) -> Core:
+    """A Core holding the values of s."""
+    c = Core()
+    c.x, c.y, c.z = (float(v) for v in s.pos_n)
+    c.vx, c.vy, c.vz = (float(v) for v in s.vel_n)
+    c.ax, c.ay, c.az = (float(v) for v in s.acc_n)
+    c.qw, c.qx, c.qy, c.qz = (float(v) for v in s.q_nb)
+    c.p, c.q, c.r = (float(v) for v in s.omega_b)
+    c.m0, c.m1, c.m2, c.m3 = (float(v) for v in s.motor_speed_radps)
+    c.used_mah, c.current_a, c.voltage_v = s.used_mah, s.current_a, s.voltage_v
+    c.on_ground, c.collided_with = s.on_ground, s.collided_with
+    return c
+
+
+def step(
+    state: PhysicsState,
+    motor_cmd: Sequence[float],
+    params: VehicleParams,
+    dt_s: float,
+    world: World,
+) -> PhysicsState:
+    """Pure step: the state dt_s later under throttles motor_cmd (front, right, back, left)."""
+    c = from_state(state)
+    run(c, motor_cmd, params, geometry(world), dt_s)
+    return to_state(c)
