@@ -4,6 +4,9 @@ Departures from the text, all ones the thesis itself argues for in section 6.3:
 - The derivative acts on the measurement, not the error, so a setpoint step gives no
   derivative kick. When the caller has a better rate (the estimator's velocity) it may pass it
   as `measurement_rate`; otherwise the measurement is differenced.
+- Setpoint changes can be shaped into a trapezoidal velocity profile (slew and acceleration
+  limits); the profile's bounded rate feeds the derivative and its acceleration an optional
+  feed-forward (AC_PID's FF), so a move is tracked without lag and without a kick.
 - Eq. 6.4's real derivator puts a pole at k·K_P/K_D; here the pole is a first-order low-pass
   with an explicit cut-off `d_filter_hz`, which is the same filter with a tunable corner.
 - The integrator is clamped to ±`i_max` and frozen while the output is saturated in the
@@ -30,14 +33,16 @@ class PidGains:
     out_max: float
     d_filter_hz: float = 10.0  # first-order low-pass on the derivative term
     setpoint_slew_per_s: float = math.inf  # max rate of change of the shaped setpoint
+    setpoint_accel_per_s2: float = math.inf  # max change of that rate (trapezoidal profile)
+    ff_accel: float = 0.0  # feed-forward gain on the shaped setpoint's acceleration
 
     def __post_init__(self) -> None:
         if min(self.kp, self.ki, self.kd, self.i_max) < 0.0:
             raise ValueError(f"PID gains and i_max must be >= 0: {self}")
         if self.out_min >= self.out_max:
             raise ValueError(f"out_min must be < out_max: {self.out_min} >= {self.out_max}")
-        if self.d_filter_hz <= 0.0 or self.setpoint_slew_per_s <= 0.0:
-            raise ValueError("d_filter_hz and setpoint_slew_per_s must be > 0")
+        if min(self.d_filter_hz, self.setpoint_slew_per_s, self.setpoint_accel_per_s2) <= 0.0:
+            raise ValueError("d_filter_hz and the setpoint slew/accel limits must be > 0")
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,6 +56,7 @@ class PidTerms:
     p: float
     i: float
     d: float
+    ff: float  # feed-forward of the shaped setpoint's acceleration
     out: float  # saturated output
     saturated: bool
 
@@ -64,6 +70,7 @@ class Pid:
         self._d = 0.0
         self._prev_measurement: float | None = None
         self._shaped: float | None = None
+        self._shaped_rate = 0.0
         self._last_out = 0.0
 
     @property
@@ -75,6 +82,10 @@ class Pid:
         """Zero the integrator."""
         self._i = 0.0
 
+    def shift_integrator(self, delta: float) -> None:
+        """Move the integrator by `delta` (clamped), when a learned trim takes over its share."""
+        self._i = min(max(self._i + delta, -self.gains.i_max), self.gains.i_max)
+
     def reset_filter(self) -> None:
         """Forget the derivative history (the next step computes no derivative)."""
         self._d = 0.0
@@ -85,17 +96,45 @@ class Pid:
         self.reset_I()
         self.reset_filter()
         self._shaped = None
+        self._shaped_rate = 0.0
 
     def engage(self, target: float, measurement: float, output: float) -> None:
         """Start so the first output is `output` (bumpless); the shaped setpoint starts at the
         measurement and slews towards `target`."""
         self.reset_filter()
         self._shaped = measurement
+        self._shaped_rate = 0.0
         self._prev_measurement = measurement
         g = self.gains
         # the shaped setpoint starts at the measurement, so P and D are zero on the first step
         self._i = min(max(output, -g.i_max), g.i_max)
         self._last_out = output
+
+    def _shape(self, target: float, dt_s: float) -> float:
+        """Move the shaped setpoint towards `target`; return its rate for the feed-forward.
+
+        Unlimited slew: the setpoint jumps (rate 0, so no kick). Slew only: a ramp. Slew and
+        accel: a trapezoidal velocity profile that brakes in time (√(2·a·distance)), so the
+        feed-forward never asks for more than the profile's acceleration."""
+        g = self.gains
+        assert self._shaped is not None
+        if not math.isfinite(g.setpoint_slew_per_s):
+            self._shaped = target
+            return 0.0
+        dist = target - self._shaped
+        want = math.copysign(min(g.setpoint_slew_per_s, math.sqrt(2.0 * g.setpoint_accel_per_s2
+                                                                   * abs(dist))), dist)
+        if math.isfinite(g.setpoint_accel_per_s2):
+            dv = g.setpoint_accel_per_s2 * dt_s
+            rate = self._shaped_rate + min(max(want - self._shaped_rate, -dv), dv)
+        else:
+            rate = want
+        move = rate * dt_s
+        if abs(move) >= abs(dist):
+            move, rate = dist, 0.0
+        self._shaped += move
+        self._shaped_rate = rate
+        return rate
 
     def update(
         self,
@@ -110,14 +149,18 @@ class Pid:
         g = self.gains
         if self._shaped is None:
             self._shaped = target
-        step = g.setpoint_slew_per_s * dt_s
-        self._shaped += min(max(target - self._shaped, -step), step)
+        prev_rate = self._shaped_rate
+        shaped_rate = self._shape(target, dt_s)
+        # clamp: the profile's last step onto the target ends its rate in one tick
+        accel = min(max((shaped_rate - prev_rate) / dt_s, -g.setpoint_accel_per_s2),
+                    g.setpoint_accel_per_s2)
+        ff = g.ff_accel * accel
         error = self._shaped - measurement
 
         if measurement_rate is not None:
-            d_raw = -g.kd * measurement_rate
+            d_raw = g.kd * (shaped_rate - measurement_rate)
         elif self._prev_measurement is not None:
-            d_raw = -g.kd * (measurement - self._prev_measurement) / dt_s
+            d_raw = g.kd * (shaped_rate - (measurement - self._prev_measurement) / dt_s)
         else:
             d_raw = 0.0
         self._prev_measurement = measurement
@@ -126,12 +169,12 @@ class Pid:
 
         p = g.kp * error
         i_next = self._i + g.ki * error * dt_s
-        unsat = p + i_next + self._d
+        unsat = p + i_next + self._d + ff
         # conditional integration: don't integrate further into a saturated output
         if (unsat > g.out_max and error > 0.0) or (unsat < g.out_min and error < 0.0):
             i_next = self._i
         self._i = min(max(i_next, -g.i_max), g.i_max)
-        total = p + self._i + self._d
+        total = p + self._i + self._d + ff
         out = min(max(total, g.out_min), g.out_max)
         self._last_out = out
         return PidTerms(
@@ -142,6 +185,7 @@ class Pid:
             p=p,
             i=self._i,
             d=self._d,
+            ff=ff,
             out=out,
             saturated=out != total,
         )

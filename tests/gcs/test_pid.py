@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from gcs.pid import Pid, PidGains
@@ -79,7 +80,7 @@ def test_bumpless_engage_first_output_equals_present_actuator() -> None:
     terms = pid.update(2.0, 1.0, 0.025)
     # setpoint slew is unlimited by default, so P acts at once but I starts at the actuator
     assert terms.i == pytest.approx(1.7 + GAINS.ki * 1.0 * 0.025)
-    slewed = Pid(PidGains(**{**_asdict(GAINS), "setpoint_slew_per_s": 0.4}))
+    slewed = Pid(PidGains(**{**_asdict(GAINS), "kd": 0.0, "setpoint_slew_per_s": 0.4}))
     slewed.engage(target=2.0, measurement=1.0, output=1.7)
     first = slewed.update(2.0, 1.0, 0.025)
     assert first.out == pytest.approx(1.7 + 2.0 * 0.01, abs=1e-3)
@@ -93,6 +94,25 @@ def test_setpoint_slew_limits_shaped_target_rate() -> None:
     assert shaped[0] == pytest.approx(0.1)
     assert shaped[4] == pytest.approx(0.5)
     assert shaped[-1] == pytest.approx(1.0)
+
+
+def test_trapezoidal_setpoint_profile_brakes_in_time_and_feeds_forward() -> None:
+    gains = PidGains(kp=0.0, ki=0.0, kd=0.0, i_max=0.0, out_min=-9, out_max=9,
+                     setpoint_slew_per_s=1.0, setpoint_accel_per_s2=2.0, ff_accel=1.0)
+    pid = Pid(gains)
+    pid.engage(0.0, 0.0, 0.0)
+    dt = 0.01
+    shaped, ffs = [], []
+    for _ in range(300):
+        t = pid.update(1.0, 0.0, dt)
+        shaped.append(t.shaped_target)
+        ffs.append(t.ff)
+    rates = np.diff(shaped) / dt
+    assert max(rates) <= 1.0 + 1e-9
+    assert max(np.abs(ffs)) <= 2.0 + 1e-9
+    assert shaped[-1] == pytest.approx(1.0)
+    assert max(shaped) <= 1.0 + 1e-9  # never overshoots the target
+    assert ffs[0] == pytest.approx(2.0)
 
 
 def test_bad_gains_rejected() -> None:

@@ -1,0 +1,149 @@
+"""Altitude controller per the thesis's Fig. 6.2, on an ArduCopter throttle stick.
+
+The PID acts on the altitude error and outputs a vertical acceleration (K_P in s⁻², K_I in s⁻³,
+K_D in s⁻¹, as the figure's units say); the thrust is U = m·(g + PID)/(cos φ·cos θ). The thesis
+then scales the output to 1000..2000 directly; here U is mapped to a motor throttle through the
+hover throttle (thrust ∝ throttle, hover ⇔ m·g) and to a stick PWM through the inverse of the
+firmware's manual throttle curve. The derivative uses the estimator's velocity (the derivative of
+the measurement, no kick). The hover throttle is learned slowly in steady hover, as ArduCopter
+learns MOT_THST_HOVER (10 s time constant).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from gcs.estimation import GRAVITY_MPS2, AltEstimate
+from gcs.pid import Pid, PidGains, PidTerms
+from gcs.thrust_curve import ThrottleCurve
+
+
+def _default_alt_gains() -> PidGains:
+    return PidGains(
+        kp=4.0,  # s⁻²: with kd 3.2 a damping ratio of 0.8 at 2 rad/s
+        ki=1.0,  # s⁻³
+        kd=3.2,  # s⁻¹
+        i_max=3.0,  # m/s² of trim the integrator may hold
+        out_min=-6.0,
+        out_max=6.0,
+        d_filter_hz=8.0,
+        setpoint_slew_per_s=1.0,
+        setpoint_accel_per_s2=1.5,
+        ff_accel=1.0,  # the output is an acceleration: the profile's own goes straight through
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class AltitudeControllerParams:
+    """Tuning of the altitude loop. Mass from thesis ch. 7 (1.63 kg)."""
+
+    mass_kg: float = 1.63
+    gains: PidGains = field(default_factory=_default_alt_gains)
+    max_tilt_rad: float = math.radians(45.0)  # beyond this the cosine compensation stops growing
+    hover_learn_tc_s: float = 10.0
+    hover_learn_max_vel_mps: float = 0.2
+    hover_learn_max_err_m: float = 0.1
+    hover_min: float = 0.15
+    hover_max: float = 0.8
+    throttle_min_us: int = 1000
+    throttle_max_us: int = 2000
+
+    def __post_init__(self) -> None:
+        if self.mass_kg <= 0.0 or self.hover_learn_tc_s <= 0.0:
+            raise ValueError("mass_kg and hover_learn_tc_s must be > 0")
+        if not 0.0 < self.hover_min < self.hover_max < 1.0:
+            raise ValueError("need 0 < hover_min < hover_max < 1")
+
+
+@dataclass(frozen=True, slots=True)
+class AltControlOutput:
+    """One step of the altitude loop: the PID terms and what became of them."""
+
+    setpoint_m: float
+    alt_m: float
+    error_m: float
+    p: float
+    i: float
+    d: float
+    accel_cmd_mps2: float
+    thrust_n: float
+    motor_throttle: float  # 0..1
+    hover_throttle: float  # learned, 0..1
+    throttle_us: int
+    saturated: bool
+
+
+class AltitudeController:
+    """Altitude PID → thrust → motor throttle → throttle stick PWM."""
+
+    def __init__(self, params: AltitudeControllerParams, curve: ThrottleCurve,
+                 hover_throttle: float | None = None) -> None:
+        self.params = params
+        self.curve = curve
+        self.pid = Pid(params.gains)
+        h = curve.mid_output if hover_throttle is None else hover_throttle
+        self.hover_throttle = min(max(h, params.hover_min), params.hover_max)
+
+    def _tilt(self, roll_rad: float, pitch_rad: float) -> float:
+        c = math.cos(roll_rad) * math.cos(pitch_rad)
+        return max(c, math.cos(self.params.max_tilt_rad))
+
+    def accel_for_throttle(self, throttle_us: float, roll_rad: float, pitch_rad: float) -> float:
+        """The vertical acceleration command a stick PWM stands for (used for bumpless engage)."""
+        out = self.curve.output(throttle_us) * self._tilt(roll_rad, pitch_rad)
+        return GRAVITY_MPS2 * (out / self.hover_throttle - 1.0)
+
+    def engage(self, estimate: AltEstimate, throttle_us: float | None,
+               roll_rad: float = 0.0, pitch_rad: float = 0.0) -> None:
+        """Take over from a pilot's stick without a jump (None: start from hover, I = 0)."""
+        a0 = 0.0
+        if throttle_us is not None:
+            a0 = self.accel_for_throttle(throttle_us, roll_rad, pitch_rad)
+        self.pid.engage(estimate.alt_m, estimate.alt_m, a0)
+
+    def update(self, setpoint_m: float, estimate: AltEstimate, roll_rad: float, pitch_rad: float,
+               dt_s: float) -> AltControlOutput:
+        """One step: setpoint altitude (up, m) and the estimate → throttle stick PWM."""
+        p = self.params
+        terms: PidTerms = self.pid.update(setpoint_m, estimate.alt_m, dt_s,
+                                          measurement_rate=estimate.vel_mps)
+        tilt = self._tilt(roll_rad, pitch_rad)
+        thrust = p.mass_kg * (GRAVITY_MPS2 + terms.out) / tilt
+        motor = self.hover_throttle * thrust / (p.mass_kg * GRAVITY_MPS2)
+        stick = self.curve.stick_us(motor)
+        throttle_us = round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
+        self._learn_hover(motor * tilt, terms, estimate, dt_s)
+        return AltControlOutput(
+            setpoint_m=terms.shaped_target,
+            alt_m=estimate.alt_m,
+            error_m=terms.error,
+            p=terms.p,
+            i=terms.i,
+            d=terms.d,
+            accel_cmd_mps2=terms.out,
+            thrust_n=thrust,
+            motor_throttle=motor,
+            hover_throttle=self.hover_throttle,
+            throttle_us=throttle_us,
+            saturated=terms.saturated,
+        )
+
+    def _learn_hover(self, level_motor: float, terms: PidTerms, est: AltEstimate,
+                     dt_s: float) -> None:
+        p = self.params
+        steady = (abs(est.vel_mps) < p.hover_learn_max_vel_mps
+                  and abs(terms.error) < p.hover_learn_max_err_m
+                  and not terms.saturated and not est.coasting)
+        if not steady:
+            return
+        # the throttle that holds the vehicle level (without the PID's acceleration) is hover;
+        # the integrator then hands its share over to the learned value
+        k = dt_s / (dt_s + p.hover_learn_tc_s)
+        new = self.hover_throttle + k * (level_motor - self.hover_throttle)
+        new = min(max(new, p.hover_min), p.hover_max)
+        # keep the total command unchanged: what hover gains, the integrator gives back
+        scale = GRAVITY_MPS2 / self.hover_throttle
+        shift = (new - self.hover_throttle) * scale
+        self.pid.shift_integrator(-shift)
+        self.hover_throttle = new

@@ -1,0 +1,125 @@
+"""Station configuration: frozen dataclasses with the thesis's values, overridable from TOML.
+
+A TOML file mirrors the dataclasses' nesting, e.g.
+
+    period_s = 0.025
+    estimator_kind = "kalman"
+    [altitude]
+    mass_kg = 1.63
+    [altitude.gains]
+    kp = 4.0
+
+Unknown keys and wrong types are errors that name the file and the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+import tomllib
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gcs.altitude_controller import AltitudeControllerParams
+from gcs.errors import UsageError
+from gcs.estimation import EstimatorParams
+from gcs.position_controller import PositionControllerParams
+
+
+class EstimatorKind(enum.Enum):
+    """Which altitude estimator flies."""
+
+    KALMAN = "kalman"
+    COMPLEMENTARY = "complementary"
+    DEAD_RECKONING = "dead_reckoning"
+
+
+@dataclass(frozen=True, slots=True)
+class FlightProfile:
+    """How `fly` takes off, holds and lands."""
+
+    takeoff_climb_mps: float = 0.5  # setpoint ramp while taking off
+    land_descent_mps: float = 0.3
+    land_handover_alt_m: float = 0.15  # below this, LAND mode / throttle down finishes the job
+    settle_s: float = 4.0  # after reaching the hold altitude, before the hold is scored
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            if getattr(self, f.name) <= 0.0:
+                raise ValueError(f"{f.name} must be > 0")
+
+
+@dataclass(frozen=True, slots=True)
+class StationConfig:
+    """Everything the station's loop needs; thesis values as defaults (25 ms period)."""
+
+    period_s: float = 0.025
+    estimator_kind: EstimatorKind = EstimatorKind.KALMAN
+    estimator: EstimatorParams = field(default_factory=EstimatorParams)
+    altitude: AltitudeControllerParams = field(default_factory=AltitudeControllerParams)
+    position: PositionControllerParams = field(default_factory=PositionControllerParams)
+    flight: FlightProfile = field(default_factory=FlightProfile)
+    events_kept: int = 200
+
+    def __post_init__(self) -> None:
+        if not 0.001 <= self.period_s <= 1.0:
+            raise ValueError(f"period_s must be in [0.001, 1], got {self.period_s}")
+
+
+def _build(base: Any, data: dict[str, Any], where: str) -> Any:
+    """`base` (a dataclass instance) with the fields in `data` replaced, checked and converted."""
+    cls = type(base)
+    hints = typing.get_type_hints(cls)
+    names = {f.name for f in dataclasses.fields(cls)}
+    kwargs: dict[str, Any] = {}
+    for key, value in data.items():
+        if key not in names:
+            raise UsageError(f"{where}{key}: unknown key; expected one of {sorted(names)}")
+        kwargs[key] = _convert(hints[key], getattr(base, key), value, f"{where}{key}")
+    try:
+        return dataclasses.replace(base, **kwargs)
+    except (TypeError, ValueError) as exc:
+        raise UsageError(f"{where.rstrip('. ')}: {exc}") from None
+
+
+def _convert(hint: Any, default: Any, value: Any, where: str) -> Any:
+    if dataclasses.is_dataclass(hint):
+        if not isinstance(value, dict):
+            raise UsageError(f"{where}: expected a table, got {value!r}")
+        return _build(default, value, where + ".")
+    if isinstance(hint, type) and issubclass(hint, enum.Enum):
+        try:
+            return hint(value)
+        except ValueError:
+            allowed = [m.value for m in hint]
+            raise UsageError(f"{where}: expected one of {allowed}, got {value!r}") from None
+    if hint is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise UsageError(f"{where}: expected a number, got {value!r}")
+        if not math.isfinite(float(value)):
+            raise UsageError(f"{where}: expected a finite number, got {value!r}")
+        return float(value)
+    if hint is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise UsageError(f"{where}: expected an integer, got {value!r}")
+        return value
+    return value
+
+
+def load_config(path: str | Path | None) -> StationConfig:
+    """Defaults, overridden by the TOML file at `path` (None: defaults only)."""
+    if path is None:
+        return StationConfig()
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise UsageError(f"{p}: no such config file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UsageError(f"{p}: cannot read config file ({exc})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise UsageError(f"{p}: not valid TOML ({exc})") from None
+    return _build(StationConfig(), data, f"{p}: ")

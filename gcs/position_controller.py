@@ -1,0 +1,132 @@
+"""Horizontal position hold and yaw hold from motion capture, on ArduCopter's sticks.
+
+Per axis (north, east) a PID turns the position error into a horizontal acceleration; that is
+rotated into the heading frame (forward, right) and turned into lean angles (tan θ = a/g), then
+into stick PWM at ArduCopter's ANGLE_MAX per full deflection. In ArduCopter, pitch stick LOW is
+nose down (forward) and roll stick HIGH is roll right; the yaw stick commands a yaw rate.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from firmware_link.records import MocapPose, Quat, RcCommand
+from gcs.estimation import GRAVITY_MPS2
+from gcs.pid import Pid, PidGains
+
+
+def _default_xy_gains() -> PidGains:
+    return PidGains(kp=1.2, ki=0.1, kd=1.6, i_max=0.5, out_min=-2.5, out_max=2.5,
+                    d_filter_hz=3.0, setpoint_slew_per_s=0.7)
+
+
+@dataclass(frozen=True, slots=True)
+class PositionControllerParams:
+    """Tuning of the horizontal loop; stick scaling as ArduCopter's defaults."""
+
+    gains_xy: PidGains = field(default_factory=_default_xy_gains)
+    max_lean_rad: float = math.radians(15.0)
+    angle_max_rad: float = math.radians(45.0)  # ANGLE_MAX: lean at full stick
+    yaw_p_per_s: float = 1.5
+    yaw_rate_max_rps: float = math.radians(60.0)
+    yaw_full_stick_rps: float = math.radians(202.5)  # ACRO_YAW_P 4.5 × 45°/s
+    stick_half_range_us: int = 500
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.max_lean_rad <= self.angle_max_rad:
+            raise ValueError("need 0 < max_lean_rad <= angle_max_rad")
+
+
+@dataclass(frozen=True, slots=True)
+class PositionSetpoint:
+    """Where to hold: NED north/east (m) and yaw (rad, None = keep the present heading)."""
+
+    north_m: float
+    east_m: float
+    yaw_rad: float | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class PositionCommand:
+    """One step of the horizontal loop."""
+
+    error_n_m: float
+    error_e_m: float
+    acc_fwd_mps2: float
+    acc_right_mps2: float
+    pitch_rad: float  # commanded, positive nose up
+    roll_rad: float  # commanded, positive right
+    yaw_error_rad: float
+    roll_us: int
+    pitch_us: int
+    yaw_us: int
+
+
+def yaw_from_quat(q_nb: Quat) -> float:
+    """Heading (rad) of a body→NED quaternion (w, x, y, z), ZYX convention."""
+    w, x, y, z = q_nb
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def wrap_pi(a: float) -> float:
+    """Angle wrapped to [-π, π)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class PositionController:
+    """North/east PIDs → lean angles → roll/pitch sticks; yaw P → yaw-rate stick."""
+
+    def __init__(self, params: PositionControllerParams | None = None) -> None:
+        self.params = params or PositionControllerParams()
+        self.pid_n = Pid(self.params.gains_xy)
+        self.pid_e = Pid(self.params.gains_xy)
+        self._yaw_hold: float | None = None
+
+    def reset(self) -> None:
+        """Forget integrators, filters and the held heading."""
+        self.pid_n.reset()
+        self.pid_e.reset()
+        self._yaw_hold = None
+
+    def _stick(self, value: float, full_scale: float) -> int:
+        half = self.params.stick_half_range_us
+        return round(1500 + max(-1.0, min(1.0, value / full_scale)) * half)
+
+    def update(self, setpoint: PositionSetpoint, pose: MocapPose, dt_s: float) -> PositionCommand:
+        """One step against the latest motion-capture pose."""
+        p = self.params
+        n, e, _ = pose.pos_n
+        tn = self.pid_n.update(setpoint.north_m, n, dt_s)
+        te = self.pid_e.update(setpoint.east_m, e, dt_s)
+        yaw = yaw_from_quat(pose.q_nb)
+        c, s = math.cos(yaw), math.sin(yaw)
+        fwd = c * tn.out + s * te.out
+        right = -s * tn.out + c * te.out
+        nose_down = max(-p.max_lean_rad, min(p.max_lean_rad, math.atan2(fwd, GRAVITY_MPS2)))
+        roll = max(-p.max_lean_rad, min(p.max_lean_rad, math.atan2(right, GRAVITY_MPS2)))
+        if setpoint.yaw_rad is not None:
+            self._yaw_hold = setpoint.yaw_rad
+        elif self._yaw_hold is None:
+            self._yaw_hold = yaw
+        yaw_err = wrap_pi(self._yaw_hold - yaw)
+        rate = max(-p.yaw_rate_max_rps, min(p.yaw_rate_max_rps, p.yaw_p_per_s * yaw_err))
+        return PositionCommand(
+            error_n_m=tn.error,
+            error_e_m=te.error,
+            acc_fwd_mps2=fwd,
+            acc_right_mps2=right,
+            pitch_rad=-nose_down,
+            roll_rad=roll,
+            yaw_error_rad=yaw_err,
+            roll_us=self._stick(roll, p.angle_max_rad),
+            # pitch stick low = nose down: the stick follows the (nose-up positive) pitch angle
+            pitch_us=self._stick(-nose_down, p.angle_max_rad),
+            yaw_us=self._stick(rate, p.yaw_full_stick_rps),
+        )
+
+    @staticmethod
+    def apply(cmd: PositionCommand, throttle_us: int) -> RcCommand:
+        """The full stick command with the altitude loop's throttle."""
+        return RcCommand(roll_us=cmd.roll_us, pitch_us=cmd.pitch_us, throttle_us=throttle_us,
+                         yaw_us=cmd.yaw_us)
