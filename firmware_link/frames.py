@@ -8,6 +8,7 @@ module otherwise.
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable
 from typing import Any
 
@@ -29,6 +30,24 @@ class _NoFile:
         """Never used: the endpoint packs and writes frames itself."""
 
 
+class _Parser(mavlink.MAVLink):
+    """pymavlink's parser, checking a frame's signature before trusting its timestamp.
+
+    pymavlink records a stream's timestamp before it compares signatures, so one forged frame
+    with a far-future timestamp would make every genuine frame after it look replayed. Checking
+    the signature first closes that hole.
+    """
+
+    def check_signature(self, msgbuf: bytearray, srcSystem: int, srcComponent: int) -> bool:
+        key = self.signing.secret_key
+        if key is None:
+            return False
+        digest = hashlib.sha256(key + bytes(msgbuf[:-6])).digest()[:6]
+        if digest != bytes(msgbuf[-6:]):
+            return False
+        return bool(super().check_signature(msgbuf, srcSystem, srcComponent))
+
+
 class FrameEndpoint:
     """Decoded messages from a transport, and encoded messages to it, with stats and a tap."""
 
@@ -45,7 +64,7 @@ class FrameEndpoint:
         self.tally = StatsTally()
         self._clock = clock
         self._on_raw = on_raw
-        self.parser = mavlink.MAVLink(_NoFile(), source_system, source_component)
+        self.parser = _Parser(_NoFile(), source_system, source_component)
         self.parser.robust_parsing = True
         self._encoder_v1 = mavlink1.MAVLink(_NoFile(), source_system, source_component)
         self.wire = WireVersion.V1

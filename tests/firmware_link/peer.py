@@ -171,6 +171,7 @@ class FakeVehicle:
                     client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
                     with self._lock:
                         self._client = client
+                    next_hb = 0.0  # greet a new station at once
                     continue
                 try:
                     data = os.read(fd, 4096) if self._master >= 0 else self._client.recv(4096)

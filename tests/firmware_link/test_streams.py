@@ -1,0 +1,104 @@
+"""Stream planning against the link's byte budget, and the thesis's bring-up steps."""
+
+from __future__ import annotations
+
+import pytest
+
+from firmware_link import DataStream, LinkError, StreamWanted, plan_streams, wanted_streams
+from firmware_link.protocol import WireVersion, frame_overhead_bytes, payload_bytes
+from firmware_link.records import Dialect
+from firmware_link.streams import bring_up_periods_ms, measured_rate_hz, step_plan
+
+SERIAL_115200 = 11520.0
+
+
+def test_frame_overheads_match_the_wire_formats() -> None:
+    assert frame_overhead_bytes(WireVersion.V1) == 8
+    assert frame_overhead_bytes(WireVersion.V2) == 12
+    assert frame_overhead_bytes(WireVersion.V2, signed=True) == 25
+    assert payload_bytes("ATTITUDE") == 28
+    assert payload_bytes("RC_CHANNELS_OVERRIDE", WireVersion.V1) == 18
+
+
+@pytest.mark.parametrize(
+    ("dialect", "wire", "signed", "grouped"),
+    [
+        (Dialect.APM25, WireVersion.V1, False, True),
+        (Dialect.COPTER4, WireVersion.V2, False, False),
+        (Dialect.COPTER4, WireVersion.V2, True, False),
+    ],
+)
+def test_default_plans_fit_115200_baud_with_fast_streams_at_40_hz(
+    dialect, wire, signed, grouped
+) -> None:
+    plan = plan_streams(
+        SERIAL_115200, wanted_streams(dialect), wire=wire, signed=signed, grouped=grouped
+    )
+    assert plan.total_bytes_per_s <= 0.8 * SERIAL_115200 + 1e-6
+    assert plan.utilisation_pct is not None and plan.utilisation_pct <= 80.0 + 1e-6
+    assert plan.rate_of("ATTITUDE") == 40.0
+    assert plan.rate_of("RAW_IMU") == 40.0
+    sonar = "RANGEFINDER" if dialect is Dialect.APM25 else "DISTANCE_SENSOR"
+    assert plan.rate_of(sonar) == 40.0
+    for r in plan.rates:
+        assert r.bytes_per_s == pytest.approx(r.frame_bytes * r.rate_hz)
+        overhead = frame_overhead_bytes(wire, signed)
+        assert r.frame_bytes == payload_bytes(r.message, wire) + overhead
+    assert "of 11520 B/s" in plan.budget_lines()[-1]
+
+
+def test_a_squeezed_link_keeps_priorities_and_trims_the_tail() -> None:
+    wanted = [
+        StreamWanted("ATTITUDE", 40.0, 10.0, DataStream.EXTRA1),
+        StreamWanted("VFR_HUD", 40.0, 2.0, DataStream.EXTRA2),
+    ]
+    # ATTITUDE costs 40 B/frame on v2, VFR_HUD 32: a 2400 B/s budget fits ATTITUDE at 40 Hz
+    # (1600 B/s) and leaves VFR_HUD the rest: its 2 Hz floor plus what remains.
+    plan = plan_streams(3000.0, wanted, max_utilisation=0.8)
+    assert plan.rate_of("ATTITUDE") == 40.0
+    assert plan.rate_of("VFR_HUD") == pytest.approx((2400.0 - 1600.0) / 32.0)
+    assert plan.total_bytes_per_s == pytest.approx(2400.0)
+
+
+def test_grouped_plan_moves_a_group_together_in_whole_hz() -> None:
+    wanted = [
+        StreamWanted("ATTITUDE", 40.0, 10.0, DataStream.EXTRA1),
+        StreamWanted("SIMSTATE", 5.0, 1.0, DataStream.EXTRA1),
+        StreamWanted("VFR_HUD", 40.0, 2.0, DataStream.EXTRA2),
+    ]
+    plan = plan_streams(5000.0, wanted, wire=WireVersion.V1, grouped=True)
+    assert plan.rate_of("SIMSTATE") == plan.rate_of("ATTITUDE") == 40.0
+    assert plan.rate_of("VFR_HUD") == int(plan.rate_of("VFR_HUD"))
+    assert plan.rate_of("VFR_HUD") == 17.0  # (4000 - 88 * 40) / 28 rounded down
+    assert plan.total_bytes_per_s <= 4000.0
+    assert plan.group_rates()[DataStream.EXTRA1] == 40.0
+
+
+def test_minimum_rates_that_cannot_fit_are_refused() -> None:
+    wanted = [StreamWanted("ATTITUDE", 40.0, 40.0, DataStream.EXTRA1)]
+    with pytest.raises(LinkError, match="telemetry minimum needs 1600 B/s"):
+        plan_streams(960.0, wanted)
+
+
+def test_unlimited_link_gets_every_wanted_rate() -> None:
+    plan = plan_streams(None, wanted_streams(Dialect.COPTER4), signed=True)
+    assert plan.utilisation_pct is None
+    assert plan.rate_of("SIM_STATE") == 10.0
+    assert "no capacity limit" in plan.budget_lines()[-1]
+
+
+def test_bring_up_steps_go_from_100_ms_to_25_ms_in_five_steps() -> None:
+    periods = bring_up_periods_ms()
+    assert periods == (100.0, 85.0, 70.0, 55.0, 40.0, 25.0)
+    plan = plan_streams(None, wanted_streams(Dialect.APM25), wire=WireVersion.V1, grouped=True)
+    first = step_plan(plan, periods[0], whole_hz=True)
+    last = step_plan(plan, periods[-1], whole_hz=True)
+    assert first["ATTITUDE"] == 10.0 and last["ATTITUDE"] == 40.0
+    assert first["SYS_STATUS"] == last["SYS_STATUS"] == 2.0
+    assert step_plan(plan, 85.0, whole_hz=False)["ATTITUDE"] == pytest.approx(1000 / 85)
+
+
+def test_measured_rate_uses_intervals_over_their_span() -> None:
+    stamps = [0.1 + k * 0.025 for k in range(41)]
+    assert measured_rate_hz(stamps, 1.0) == pytest.approx(40.0)
+    assert measured_rate_hz([], 1.0) == 0.0
