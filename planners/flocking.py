@@ -1,0 +1,575 @@
+"""Leader–follower triangular flocking of thesis Chapter 9, one planning step at a time.
+
+The team is the binary tree of :mod:`planners.formation`. Each step, driven by every vehicle's
+position and its six IR readings:
+
+* the root leader moves one grid step ``d`` towards the common goal along one axis (Definition 7's
+  cost favours straight moves), avoiding what its sensors see with the obstacle classes of §9.3.3
+  (single-sided: sidestep towards the goal; partition: pass over; box: back off);
+* every leader that is not avoiding sends its set position to its two followers (eq. 9.1), and
+  nothing while it avoids; followers never answer;
+* a follower's goal is its triangle slot beside and behind the last position its leader sent; it
+  waits there when no message comes, and boosts to ``boost × d`` per step to catch up when one
+  does (§9.3.3 b);
+* a follower whose way is blocked either avoids on its own sensors (``SELF_AVOID``) or, with the
+  leader's heads-up (``HEADS_UP``), walks the trail of positions its leader sent — a path known
+  to be free — in its own altitude layer, so that through a narrow opening the team passes one
+  by one at different heights and may queue closer than on one level (layered formation, §9.4);
+* once the root holds the common goal, every vehicle flies to its individual goal (Algorithm
+  9.3.4), or to its final slot around the common goal when it has none.
+
+A safety guard runs last for every vehicle, in tree order: a set position is accepted only if it
+stays ``safe_distance_m`` (3-D) from every set position already granted this step and from the
+current position of every vehicle not yet planned; otherwise the vehicle holds, which is always
+safe by the same rule. So the team never closes below the safe distance when vehicles reach their
+set positions, whatever the planner above the guard decides.
+
+Departures from the text: the thesis's ``θ`` in "degree/100" and ``P(f1) = 1 − θ`` are not used
+(a probability from an angle in those units is not well defined); the leader classifies obstacles
+from active sensors as §9.3.3 says, but keeps a sidestep until its straight move is free plus two
+steps, since without that margin the body clips the corner it has just cleared. The leader's
+"obstacle" of eq. 9.1 is its avoidance manoeuvre, not any return on a sensor: a leader flying
+straight through a doorway with both side sensors lit still sends its positions, because they are
+the path its followers need.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planners.flock_comm import OpenLoopChannel
+from planners.formation import Formation, FormationParams, Role, rotate_f_to_n
+from planners.geometry import Vec3
+from planners.proximity import Facing, ProximityReading
+
+# The six grid moves: north, south, east, west, down, up (NED unit vectors).
+AXIS_MOVES: tuple[Vec3, ...] = (
+    (1.0, 0.0, 0.0),
+    (-1.0, 0.0, 0.0),
+    (0.0, 1.0, 0.0),
+    (0.0, -1.0, 0.0),
+    (0.0, 0.0, 1.0),
+    (0.0, 0.0, -1.0),
+)
+_HORIZONTAL = (Facing.FRONT, Facing.RIGHT, Facing.BACK, Facing.LEFT)
+
+
+class FollowerPolicy(enum.Enum):
+    """How a follower gets past an obstacle (§9.4: self avoidance or the leader's heads-up)."""
+
+    SELF_AVOID = "self_avoid"
+    HEADS_UP = "heads_up"
+
+
+class VehicleMode(enum.Enum):
+    """What a vehicle did this step."""
+
+    FORMATION = "formation"  # flying to its goal (leader: to the common goal)
+    WAITING = "waiting"  # at its goal with nothing new from its leader, or held by the guard
+    AVOIDING = "avoiding"  # manoeuvring round an obstacle on its own sensors
+    TRAIL = "trail"  # walking its leader's trail (heads-up), in its own altitude layer
+    INDIVIDUAL = "individual"  # flying to its individual goal
+    ARRIVED = "arrived"  # at its individual goal
+
+
+class Phase(enum.Enum):
+    """Common goal first, then individual goals (Algorithms 9.3.3 and 9.3.4)."""
+
+    COMMON_GOAL = "common_goal"
+    INDIVIDUAL_GOALS = "individual_goals"
+
+
+@dataclass(frozen=True, slots=True)
+class FlockParams:
+    """Tuning of the triangular flock; distances in metres, per planning step."""
+
+    step_m: float = 0.1  # grid step d (§9.3.1)
+    boost: float = 2.0  # catch-up speed factor of a follower given a new goal (§9.3.3 b)
+    catchup_distance_m: float = 0.3  # a follower boosts when its goal is farther than this
+    stop_distance_m: float = 0.3  # never step closer than this to what a sensor sees
+    goal_tolerance_m: float = 0.05
+    layer_spacing_m: float = 0.35  # altitude between layers in a narrow opening
+    n_layers: int = 3
+    trail_points: int = 800  # leader positions a follower remembers for heads-up
+    obstacle_memory: int = 400  # sensor returns a vehicle remembers, as points in NED
+    rejoin_clear_steps: int = 4  # steps with every sensor clear before leaving the trail
+    rejoin_margin_m: float = 0.45  # the way back to the slot must pass this far from returns
+    sidestep_overshoot_steps: int = 2
+    cost_weights: Vec3 = (4.0, 2.0, 6.0)  # Definition 7's A, B (even), and one for altitude
+    common_wait_steps: int = 150  # how long the root waits at the common goal for its team
+    policy: FollowerPolicy = FollowerPolicy.HEADS_UP
+    latency_steps: int = 0
+    formation: FormationParams = field(default_factory=FormationParams)
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.step_m < self.formation.safe_distance_m:
+            raise ValueError(f"step_m must be in (0, safe distance), got {self.step_m}")
+        if self.boost < 1.0:
+            raise ValueError(f"boost must be >= 1, got {self.boost}")
+        if self.n_layers < 1 or self.layer_spacing_m < 0.0:
+            raise ValueError("n_layers must be >= 1 and layer_spacing_m >= 0")
+
+
+@dataclass(frozen=True, slots=True)
+class FlockMission:
+    """Where the team goes: the common goal of the root, then optional individual goals by id."""
+
+    common_goal_n: Vec3
+    individual_goals_n: dict[int, Vec3] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, slots=True)
+class FlockStep:
+    """Output of one planning step: set positions by vehicle id, and diagnostics."""
+
+    setpoints_n: dict[int, Vec3]
+    messages_sent: int
+    modes: dict[int, VehicleMode]
+    roles: dict[int, Role]
+    phase: Phase
+    formation_error_m: float | None  # RMS slot error of followers flying in formation
+    formation_samples: tuple[float, ...]
+    leader_avoiding: bool
+    held_by_guard: tuple[int, ...]
+
+
+@dataclass(slots=True)
+class _State:
+    """Runtime state of one vehicle (tree index)."""
+
+    goal_n: Vec3 | None = None
+    trail: deque[Vec3] = field(default_factory=deque)
+    trail_idx: int = 0
+    in_trail: bool = False
+    trail_layer_on: bool = True
+    clear_steps: int = 0
+    hits: deque[Vec3] = field(default_factory=deque)
+    avoid_dir: Vec3 | None = None
+    overshoot: int = 0
+    arrived_common: bool = False
+    arrived_final: bool = False
+    make_way_from: list[Vec3] = field(default_factory=list)  # where higher-priority ones wanted
+
+
+def _add(p: Vec3, d: Vec3, s: float) -> Vec3:
+    return (p[0] + d[0] * s, p[1] + d[1] * s, p[2] + d[2] * s)
+
+
+def _dist(a: Vec3, b: Vec3) -> float:
+    return math.dist(a, b)
+
+
+class FlockPlanner:
+    """Triangular leader–follower flock; ``step`` maps positions and readings to set positions."""
+
+    name = "triangular"
+
+    def __init__(
+        self,
+        vehicle_ids: list[int],
+        mission: FlockMission,
+        heading_n: tuple[float, float],
+        params: FlockParams | None = None,
+    ) -> None:
+        if len(set(vehicle_ids)) != len(vehicle_ids) or not vehicle_ids:
+            raise ValueError(f"vehicle_ids must be unique and non-empty, got {vehicle_ids}")
+        unknown = set(mission.individual_goals_n) - set(vehicle_ids)
+        if unknown:
+            raise ValueError(f"individual goals for unknown vehicle ids {sorted(unknown)}")
+        self.params = params or FlockParams()
+        self.ids = list(vehicle_ids)
+        self.n = len(vehicle_ids)
+        self.mission = mission
+        self.heading_n = np.asarray(heading_n, dtype=float)
+        self.formation = Formation.build(self.n, self.params.formation)
+        self.channel = OpenLoopChannel(latency_steps=self.params.latency_steps)
+        self.phase = Phase.COMMON_GOAL
+        self._wait_at_common = 0
+        self._states = [_State() for _ in range(self.n)]
+        self._wanted: dict[int, Vec3] = {}  # guard-refused moves this step, by tree index
+        g = mission.common_goal_n
+        self._final_n: list[Vec3] = []
+        for k in range(self.n):
+            vid = self.ids[k]
+            if vid in mission.individual_goals_n:
+                self._final_n.append(tuple(map(float, mission.individual_goals_n[vid])))  # type: ignore[arg-type]
+            else:
+                off = rotate_f_to_n(self.formation.offsets_f[k], self.heading_n)
+                self._final_n.append((g[0] + off[0], g[1] + off[1], g[2]))
+
+    # ----- public helpers -------------------------------------------------------------------
+
+    def final_targets_n(self) -> dict[int, Vec3]:
+        """Where each vehicle ends: its individual goal, or its slot around the common goal."""
+        return {self.ids[k]: self._final_n[k] for k in range(self.n)}
+
+    def start_positions_n(self, leader_start_n: Vec3) -> dict[int, Vec3]:
+        """Formation slots around the root's start, for placing the team before take-off."""
+        out: dict[int, Vec3] = {}
+        for k in range(self.n):
+            off = rotate_f_to_n(self.formation.offsets_f[k], self.heading_n)
+            out[self.ids[k]] = (
+                leader_start_n[0] + off[0],
+                leader_start_n[1] + off[1],
+                leader_start_n[2],
+            )
+        return out
+
+    def arrived(self) -> dict[int, bool]:
+        """Whether each vehicle has reached its final target."""
+        return {self.ids[k]: self._states[k].arrived_final for k in range(self.n)}
+
+    # ----- the step -------------------------------------------------------------------------
+
+    def step(
+        self,
+        step_index: int,
+        positions_n: dict[int, Vec3],
+        readings: dict[int, ProximityReading],
+    ) -> FlockStep:
+        """Plan one step for every vehicle from its position and its IR reading."""
+        missing = [v for v in self.ids if v not in positions_n or v not in readings]
+        if missing:
+            raise ValueError(f"flock step {step_index}: no position or reading for {missing}")
+        pos = [tuple(map(float, positions_n[v])) for v in self.ids]
+        rd = [readings[v] for v in self.ids]
+        for k in range(self.n):
+            self._remember_returns(k, pos[k], rd[k])  # type: ignore[arg-type]
+        reserved: list[Vec3] = list(pos)  # type: ignore[arg-type]
+        self._wanted = {}
+        modes: dict[int, VehicleMode] = {}
+        held: list[int] = []
+        sent = 0
+        leader_avoiding = False
+        samples = self._formation_samples(pos)  # type: ignore[arg-type]
+
+        if self.phase is Phase.COMMON_GOAL:
+            self._maybe_start_individual(pos)  # type: ignore[arg-type]
+
+        for k in range(self.n):
+            p: Vec3 = pos[k]  # type: ignore[assignment]
+            if self.phase is Phase.INDIVIDUAL_GOALS:
+                sp, mode = self._individual(k, p, rd[k], reserved)
+                avoiding = mode is VehicleMode.AVOIDING
+            elif k == 0:
+                sp, mode = self._root(p, rd[0], reserved)
+                avoiding = mode is VehicleMode.AVOIDING
+                leader_avoiding = avoiding
+            else:
+                self._receive(step_index, k)
+                sp, mode = self._follower(k, p, rd[k], reserved)
+                avoiding = mode is VehicleMode.AVOIDING
+            if sp == p and k in self._wanted:
+                self._ask_to_make_way(k, self._wanted[k], reserved)
+            if sp != p and not self._guard_ok(k, sp, reserved):
+                self._ask_to_make_way(k, sp, reserved)
+                held.append(self.ids[k])
+                sp = p
+                mode = VehicleMode.WAITING if mode is not VehicleMode.AVOIDING else mode
+            if self._states[k].make_way_from:
+                sp = self._make_way(k, p, sp, rd[k], reserved)
+            reserved[k] = sp
+            modes[self.ids[k]] = mode
+            if self.phase is Phase.COMMON_GOAL:
+                sent += self.channel.offer(
+                    step_index, k, self.formation.children(k), sp, avoiding
+                )
+
+        rms = math.sqrt(sum(e * e for e in samples) / len(samples)) if samples else None
+        return FlockStep(
+            setpoints_n={self.ids[k]: reserved[k] for k in range(self.n)},
+            messages_sent=sent,
+            modes=modes,
+            roles={self.ids[k]: self.formation.role(k) for k in range(self.n)},
+            phase=self.phase,
+            formation_error_m=rms,
+            formation_samples=tuple(samples),
+            leader_avoiding=leader_avoiding,
+            held_by_guard=tuple(held),
+        )
+
+    # ----- building blocks ------------------------------------------------------------------
+
+    def _remember_returns(self, k: int, p: Vec3, reading: ProximityReading) -> None:
+        st = self._states[k]
+        for facing, axis in zip(
+            (Facing.FRONT, Facing.BACK, Facing.RIGHT, Facing.LEFT, Facing.DOWN, Facing.UP),
+            AXIS_MOVES,
+            strict=True,
+        ):
+            r = reading.get(facing)
+            if r is not None:
+                st.hits.append(_add(p, axis, r))
+        while len(st.hits) > self.params.obstacle_memory:
+            st.hits.popleft()
+
+    def _sensor_ok(self, reading: ProximityReading, d: Vec3, s: float) -> bool:
+        r = reading.along_n(d)
+        return r is None or r > s + self.params.stop_distance_m
+
+    def _guard_ok(self, k: int, sp: Vec3, reserved: list[Vec3]) -> bool:
+        safe = self.params.formation.safe_distance_m
+        return all(j == k or _dist(sp, q) >= safe for j, q in enumerate(reserved))
+
+    def _ask_to_make_way(self, k: int, wanted: Vec3, reserved: list[Vec3]) -> None:
+        """Vehicles of lower priority in the way of k's wanted move will step aside next step."""
+        safe = self.params.formation.safe_distance_m
+        for j in range(k + 1, self.n):
+            if _dist(wanted, reserved[j]) < safe:
+                self._states[j].make_way_from.append(wanted)
+
+    def _make_way(
+        self, k: int, p: Vec3, sp: Vec3, reading: ProximityReading, reserved: list[Vec3]
+    ) -> Vec3:
+        """Step away from where a higher-priority vehicle wanted to go (deadlock breaker)."""
+        st = self._states[k]
+        wanted = st.make_way_from
+        st.make_way_from = []
+        s = self.params.step_m
+
+        def margin(q: Vec3) -> float:
+            return min(_dist(q, w) for w in wanted)
+
+        best, best_margin = sp, margin(sp)
+        for d in AXIS_MOVES:
+            q = _add(p, d, s)
+            m = margin(q)
+            if m > best_margin + 1e-9 and self._sensor_ok(reading, d, s) and self._guard_ok(
+                k, q, reserved
+            ):
+                best, best_margin = q, m
+        return best
+
+    def _greedy(
+        self, p: Vec3, target: Vec3, s_max: float, reading: ProximityReading, k: int,
+        reserved: list[Vec3],
+    ) -> tuple[Vec3 | None, bool]:
+        """Best allowed axis move towards ``target``; also whether the primary move was free."""
+        w = self.params.cost_weights
+        cands: list[tuple[float, Vec3, float]] = []
+        for axis in range(3):
+            err = target[axis] - p[axis]
+            if abs(err) < 1e-9:
+                continue
+            s = min(s_max, abs(err))
+            d = AXIS_MOVES[2 * axis + (0 if err > 0 else 1)]
+            cands.append((w[axis] * s, d, s))
+        cands.sort(key=lambda c: -c[0])
+        primary_free = True
+        for i, (_, d, s) in enumerate(cands):
+            ok_sensor = self._sensor_ok(reading, d, s)
+            if i == 0 and not ok_sensor:
+                primary_free = False
+            if not ok_sensor:
+                continue
+            sp = _add(p, d, s)
+            if self._guard_ok(k, sp, reserved):
+                return sp, primary_free
+            self._wanted.setdefault(k, sp)
+        return None, primary_free
+
+    def _avoid_direction(
+        self, p: Vec3, target: Vec3, reading: ProximityReading, blocked: Vec3
+    ) -> Vec3:
+        """Obstacle class from the active sensors (§9.3.3 a) to an escape move."""
+        active = reading.active(self.params.stop_distance_m + 2 * self.params.step_m)
+        horizontal = [f for f in active if f in _HORIZONTAL]
+        vertical = active - set(_HORIZONTAL)
+        up: Vec3 = (0.0, 0.0, -1.0)
+        back: Vec3 = (-blocked[0], -blocked[1], -blocked[2])
+        # Sideways candidates perpendicular to the blocked horizontal move.
+        if blocked[2] != 0.0:
+            sides: list[Vec3] = [(1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0),
+                                 (0.0, -1.0, 0.0)]
+        else:
+            sides = [(-blocked[1], blocked[0], 0.0), (blocked[1], -blocked[0], 0.0)]
+        to_goal = np.subtract(target, p)
+        sides.sort(key=lambda d: -float(np.dot(d, to_goal)))
+        free_sides = [d for d in sides if self._sensor_ok(reading, d, self.params.step_m)]
+        can_climb = self._sensor_ok(reading, up, self.params.step_m)
+        if len(horizontal) > 1 and not vertical and can_climb:
+            return up  # partition (Π, Γ): pass over
+        if vertical and len(horizontal) > 1:
+            return back  # one-side-open box: back out
+        if free_sides:
+            return free_sides[0]  # single-sided: round it on the goal's side
+        if self._sensor_ok(reading, up, self.params.step_m):
+            return up
+        return back
+
+    def _seek(
+        self, k: int, p: Vec3, target: Vec3, s_max: float, reading: ProximityReading,
+        reserved: list[Vec3],
+    ) -> tuple[Vec3, bool]:
+        """EPBHA-style move towards ``target``: straight when free, else a held sidestep."""
+        st = self._states[k]
+        s = self.params.step_m
+        sp, primary_free = self._greedy(p, target, s_max, reading, k, reserved)
+        if primary_free and st.avoid_dir is not None:
+            if st.overshoot > 0 and self._sensor_ok(reading, st.avoid_dir, s):
+                st.overshoot -= 1
+                return _add(p, st.avoid_dir, s), True
+            st.avoid_dir = None
+        if primary_free:
+            return (sp if sp is not None else p), False
+        # The straight move is blocked by an obstacle.
+        if st.avoid_dir is None or not self._sensor_ok(reading, st.avoid_dir, s):
+            err = np.subtract(target, p)
+            axis = int(np.argmax(np.abs(err) * np.array(self.params.cost_weights)))
+            blocked = AXIS_MOVES[2 * axis + (0 if err[axis] > 0 else 1)]
+            st.avoid_dir = self._avoid_direction(p, target, reading, blocked)
+        st.overshoot = self.params.sidestep_overshoot_steps
+        if self._sensor_ok(reading, st.avoid_dir, s):
+            return _add(p, st.avoid_dir, s), True
+        return p, True
+
+    def _root(
+        self, p: Vec3, reading: ProximityReading, reserved: list[Vec3]
+    ) -> tuple[Vec3, VehicleMode]:
+        st = self._states[0]
+        goal = self.mission.common_goal_n
+        if _dist(p, goal) <= self.params.goal_tolerance_m:
+            st.arrived_common = True
+            return p, VehicleMode.WAITING
+        sp, avoiding = self._seek(0, p, goal, self.params.step_m, reading, reserved)
+        return sp, VehicleMode.AVOIDING if avoiding else VehicleMode.FORMATION
+
+    def _receive(self, step_index: int, k: int) -> None:
+        st = self._states[k]
+        par = self.formation.parent(k)
+        assert par is not None
+        for msg in self.channel.deliver(step_index, k):
+            slot = self.formation.slot_n(k, np.array(msg.pos_n[:2]), self.heading_n)
+            st.goal_n = (float(slot[0]), float(slot[1]), msg.pos_n[2])
+            st.trail.append(msg.pos_n)
+            while len(st.trail) > self.params.trail_points:
+                st.trail.popleft()
+                st.trail_idx = max(0, st.trail_idx - 1)
+
+    def _layer_offset_m(self, k: int) -> float:
+        """Altitude offset (NED z) of vehicle k's layer: 0, above, below, further above..."""
+        layer = k % self.params.n_layers
+        if layer == 0:
+            return 0.0
+        rank = (layer + 1) // 2
+        sign = -1.0 if layer % 2 == 1 else 1.0  # odd layers fly higher (z up is negative)
+        return sign * rank * self.params.layer_spacing_m
+
+    def _follower(
+        self, k: int, p: Vec3, reading: ProximityReading, reserved: list[Vec3]
+    ) -> tuple[Vec3, VehicleMode]:
+        st = self._states[k]
+        prm = self.params
+        if st.goal_n is None:
+            return p, VehicleMode.WAITING
+        if st.in_trail:
+            return self._walk_trail(k, p, reading, reserved)
+        dist = _dist(p, st.goal_n)
+        if dist <= prm.goal_tolerance_m and st.avoid_dir is None:
+            return p, VehicleMode.WAITING
+        s_max = prm.step_m * (prm.boost if dist > prm.catchup_distance_m else 1.0)
+        if prm.policy is FollowerPolicy.HEADS_UP and st.avoid_dir is None:
+            sp, primary_free = self._greedy(p, st.goal_n, s_max, reading, k, reserved)
+            if not primary_free and st.trail:
+                self._enter_trail(k, p)
+                return self._walk_trail(k, p, reading, reserved)
+            return (sp if sp is not None else p), VehicleMode.FORMATION
+        sp, avoiding = self._seek(k, p, st.goal_n, s_max, reading, reserved)
+        return sp, VehicleMode.AVOIDING if avoiding else VehicleMode.FORMATION
+
+    def _enter_trail(self, k: int, p: Vec3) -> None:
+        st = self._states[k]
+        st.in_trail = True
+        st.trail_layer_on = True
+        st.clear_steps = 0
+        dists = [_dist(p, q) for q in st.trail]
+        st.trail_idx = int(np.argmin(dists))
+
+    def _walk_trail(
+        self, k: int, p: Vec3, reading: ProximityReading, reserved: list[Vec3]
+    ) -> tuple[Vec3, VehicleMode]:
+        st = self._states[k]
+        prm = self.params
+        seen = reading.active(prm.formation.sensing_range_m)
+        st.clear_steps = 0 if seen else st.clear_steps + 1
+        if (
+            st.clear_steps >= prm.rejoin_clear_steps
+            and st.goal_n is not None
+            and self._way_is_clear(k, p, st.goal_n)
+        ):
+            st.in_trail = False
+            return self._follower(k, p, reading, reserved)
+        dz = self._layer_offset_m(k) if st.trail_layer_on else 0.0
+        while True:
+            q = st.trail[min(st.trail_idx, len(st.trail) - 1)]
+            target = (q[0], q[1], q[2] + dz)
+            if _dist(p, target) > prm.step_m * 0.5 or st.trail_idx >= len(st.trail) - 1:
+                break
+            st.trail_idx += 1
+        sp, primary_free = self._greedy(p, target, prm.step_m, reading, k, reserved)
+        if not primary_free and st.trail_layer_on and dz != 0.0:
+            st.trail_layer_on = False  # the trail is free at the leader's height, not above it
+        return (sp if sp is not None else p), VehicleMode.TRAIL
+
+    def _way_is_clear(self, k: int, p: Vec3, goal: Vec3) -> bool:
+        """No remembered return lies near the straight way from ``p`` to ``goal``."""
+        hits = self._states[k].hits
+        if not hits:
+            return True
+        a = np.asarray(p)
+        ab = np.asarray(goal) - a
+        pts = np.asarray(hits)
+        denom = float(ab @ ab)
+        t = np.zeros(len(pts)) if denom < 1e-12 else np.clip((pts - a) @ ab / denom, 0.0, 1.0)
+        closest = a + t[:, None] * ab
+        return bool(np.min(np.linalg.norm(pts - closest, axis=1)) >= self.params.rejoin_margin_m)
+
+    def _maybe_start_individual(self, pos: list[Vec3]) -> None:
+        root = self._states[0]
+        if not root.arrived_common:
+            return
+        self._wait_at_common += 1
+        settled = all(
+            self._states[k].goal_n is not None
+            and _dist(pos[k], self._states[k].goal_n) <= self.params.goal_tolerance_m  # type: ignore[arg-type]
+            for k in range(1, self.n)
+        )
+        if settled or self._wait_at_common >= self.params.common_wait_steps:
+            self.phase = Phase.INDIVIDUAL_GOALS
+            for st in self._states:
+                st.avoid_dir = None
+                st.in_trail = False
+
+    def _individual(
+        self, k: int, p: Vec3, reading: ProximityReading, reserved: list[Vec3]
+    ) -> tuple[Vec3, VehicleMode]:
+        st = self._states[k]
+        target = self._final_n[k]
+        if _dist(p, target) <= self.params.goal_tolerance_m and st.avoid_dir is None:
+            st.arrived_final = True
+            return p, VehicleMode.ARRIVED
+        st.arrived_final = False
+        sp, avoiding = self._seek(k, p, target, self.params.step_m, reading, reserved)
+        return sp, VehicleMode.AVOIDING if avoiding else VehicleMode.INDIVIDUAL
+
+    def _formation_samples(self, pos: list[Vec3]) -> list[float]:
+        """Horizontal distance of each follower in formation from its slot behind its leader."""
+        if self.phase is not Phase.COMMON_GOAL:
+            return []
+        out: list[float] = []
+        for k in range(1, self.n):
+            st = self._states[k]
+            if st.in_trail or st.avoid_dir is not None or st.goal_n is None:
+                continue
+            par = self.formation.parent(k)
+            assert par is not None
+            if self._states[par].in_trail or self._states[par].avoid_dir is not None:
+                continue
+            slot = self.formation.slot_n(k, np.array(pos[par][:2]), self.heading_n)
+            out.append(float(np.hypot(pos[k][0] - slot[0], pos[k][1] - slot[1])))
+        return out
