@@ -39,9 +39,9 @@ Where this code departs from the text, and why:
   seen; the back-off is a staircase of axis steps (back, side, back, …), each along a cone axis.
 - The "no detection range offset" of Subfunction 2 is `keep_off_m`: a move is taken only when
   its sensor sees nothing nearer than step + keep_off, and anything nearer than keep_off on
-  any side is first backed away from. Manoeuvres continue `edge_margin_steps` beyond the step
-  where an edge leaves the sensor cone, because a 22.5° half-cone stops seeing an edge before
-  the body has cleared it.
+  any side is first backed away from. Manoeuvres continue a few steps beyond the step where an
+  edge leaves the sensor cone, because a 22.5° half-cone stops seeing an edge at lateral offset
+  seen·tan 22.5°, before the body (radius `body_radius_m`) has cleared it.
 - The thesis keeps no memory; a purely reactive rule can cycle forever (re-entering a cave it
   just left). The planner counts visits per grid cell and reports a deadlock (loop) instead of
   cycling, and after a cave it climbs above the lid height it measured before moving on.
@@ -153,7 +153,7 @@ class EpbhaParams:
     sensor_range_m: float = 0.5  # §8.6
     sensor_cone_deg: float = 45.0  # §8.6, full cone angle
     keep_off_m: float = 0.2  # Subfunction 2's offset: >= body radius 0.15 m plus 5 cm
-    edge_margin_steps: int = 2  # extra steps once an edge leaves the cone (ceil(0.15 / 0.1))
+    body_radius_m: float = 0.17  # edge clearance wanted: the 0.15 m body plus 2 cm
     max_visits: int = 4  # visits of one cell after which the planner reports a loop
 
     def __post_init__(self) -> None:
@@ -168,8 +168,8 @@ class EpbhaParams:
                 f"EPBHA step_m + keep_off_m ({self.step_m + self.keep_off_m} m) must be below "
                 f"the sensor range ({self.sensor_range_m} m), or a blocked move is never seen"
             )
-        if self.edge_margin_steps < 0 or self.max_visits < 1:
-            raise ValueError("EPBHA edge_margin_steps must be >= 0 and max_visits >= 1")
+        if self.body_radius_m < 0.0 or self.max_visits < 1:
+            raise ValueError("EPBHA body_radius_m must be >= 0 and max_visits >= 1")
 
     @property
     def blocked_below_m(self) -> float:
@@ -210,6 +210,7 @@ class _Manoeuvre:
     over: Move  # the bypass direction (up in the XY plane)
     stage: int = 0
     clear_steps: int = 0
+    last_seen_m: float = 0.0  # the watched edge's distance when the cone last saw it
     back_next: bool = True
     lid_z_m: float | None = None  # NED z of a cave's lid underside, when one was measured
 
@@ -441,7 +442,6 @@ class Epbha:
         """The manoeuvre's next move, None when it has finished; hovers when stuck."""
         man = self._manoeuvre
         assert man is not None
-        margin = self.params.edge_margin_steps
 
         def go(move: Move, reason: Reason) -> Decision:
             return self._decide(self._neighbour(pos, move), Status.MOVING, reason, man.kind,
@@ -449,8 +449,8 @@ class Epbha:
 
         if man.kind is ObstacleClass.SINGLE_SIDED:
             if man.stage == 0:
-                man.clear_steps = 0 if self._active(reading, man.heading) else man.clear_steps + 1
-                if man.clear_steps <= margin:
+                man.clear_steps = self._watch(man, reading, man.heading)
+                if man.clear_steps <= self._margin_steps(man):
                     if self._free(reading, man.side):
                         return go(man.side, Reason.GO_AROUND)
                     # The way around is closed too: it is a partition after all.
@@ -459,9 +459,9 @@ class Epbha:
                 man.stage, man.clear_steps = 1, 0
             if man.stage == 1:
                 beside = man.side.opposite
-                man.clear_steps = 0 if self._active(reading, beside) else man.clear_steps + 1
+                man.clear_steps = self._watch(man, reading, beside)
                 heading_improves = not self._aligned(pos, man.heading.axis)
-                if man.clear_steps <= margin and heading_improves and self._free(
+                if man.clear_steps <= self._margin_steps(man) and heading_improves and self._free(
                     reading, man.heading
                 ):
                     return go(man.heading, Reason.PASS_ALONG)
@@ -470,9 +470,10 @@ class Epbha:
 
         if man.kind is ObstacleClass.PARTITION:
             above_lid = man.lid_z_m is None or pos[2] < man.lid_z_m - self.params.keep_off_m
-            front_seen = self._active(reading, man.heading)
-            man.clear_steps = 0 if (front_seen or not above_lid) else man.clear_steps + 1
-            if man.clear_steps <= margin:
+            man.clear_steps = self._watch(man, reading, man.heading)
+            if not above_lid:
+                man.clear_steps = 0
+            if man.clear_steps <= self._margin_steps(man):
                 if self._free(reading, man.over):
                     return go(man.over, Reason.PASS_OVER)
                 # Cannot pass over: go around on a free side, else it is a box to back out of.
@@ -502,6 +503,20 @@ class Epbha:
             return go(man.side, Reason.BACK_OFF)
         self._manoeuvre = None
         return self._hover(pos, Reason.DEADLOCK_BLOCKED, options, ObstacleClass.CAVE, table)
+
+    def _watch(self, man: _Manoeuvre, reading: ProximityReading, move: Move) -> int:
+        """Steps since the sensor along `move` last saw the edge being cleared."""
+        seen = reading.along_n(move.vec())
+        if seen is not None and seen <= self.params.sensor_range_m:
+            man.last_seen_m = seen
+            return 0
+        return man.clear_steps + 1
+
+    def _margin_steps(self, man: _Manoeuvre) -> int:
+        """Extra steps after the edge left the cone until the body has cleared it."""
+        half = math.radians(self.params.sensor_cone_deg) / 2.0
+        short_m = self.params.body_radius_m - man.last_seen_m * math.tan(half)
+        return max(0, math.ceil(short_m / self.params.step_m - 1e-9))
 
     # --- decisions --------------------------------------------------------------------
 

@@ -1,10 +1,10 @@
 """The thesis's test scenes (Ch. 8) and seeded random cluttered rooms, as pure data.
 
-Local NED metres, z down: a box from alt 0 to 0.8 m spans z from -0.8 to 0. The named scenes are
-the table with a box under it (Fig. 8.4: the goal is beside the box, under the table top), the
-Π and Γ partitions (read as plan views: a wall with two wings forming a pocket, and a wall with
-one wing forming a corner), a one-side-open box (a cave open toward the vehicle) and a dead end
-(a narrow roofed passage ending in a wall).
+Local NED metres, z down: a box from alt 0 to 0.8 m spans z from -0.8 to 0. The named scenes:
+the table with a box under it (Fig. 8.4: the goal is above the box, under the table top; the box
+stands off-centre, toward the table's east edge), the Π and Γ partitions (read as plan views: a
+wall with two wings forming a pocket, and a wall with one wing forming a corner), a one-side-open
+box (a cave open toward the vehicle) and a dead end (a narrow roofed passage ending in a wall).
 """
 
 from __future__ import annotations
@@ -55,10 +55,10 @@ def table_scene() -> Scene:
         (
             _box("table_top", (3.0, 4.2), (1.2, 2.8), top),
             *legs,
-            _box("box_under_table", (3.4, 3.8), (1.8, 2.2), (0.0, 0.25)),
+            _box("box_under_table", (3.4, 3.8), (2.2, 2.6), (0.0, 0.25)),
         ),
     )
-    return Scene("table", world, (0.5, 2.0, -1.0), (3.6, 2.0, -0.5),
+    return Scene("table", world, (0.5, 2.4, -1.0), (3.6, 2.4, -0.5),
                  "Fig. 8.4: reach the box under the table")
 
 
@@ -92,15 +92,15 @@ def gamma_partition_scene() -> Scene:
 
 
 def open_box_scene() -> Scene:
-    """A one-side-open box (cave): walls, a back and a lid, open toward the vehicle."""
+    """A one-side-open box (cave), 0.7 m deep: walls, a back and a lid, open toward the vehicle."""
     h = (0.0, 1.3)
     world = World(
         ROOM,
         (
-            _box("cave_back", (4.0, 4.0 + WALL_M), (1.35, 2.65), h),
-            _box("cave_wall_w", (3.0, 4.0), (1.35, 1.35 + WALL_M), h),
-            _box("cave_wall_e", (3.0, 4.0), (2.65 - WALL_M, 2.65), h),
-            _box("cave_lid", (3.0, 4.0 + WALL_M), (1.35, 2.65), (1.3, 1.3 + WALL_M)),
+            _box("cave_back", (3.7, 3.7 + WALL_M), (1.35, 2.65), h),
+            _box("cave_wall_w", (3.0, 3.7), (1.35, 1.35 + WALL_M), h),
+            _box("cave_wall_e", (3.0, 3.7), (2.65 - WALL_M, 2.65), h),
+            _box("cave_lid", (3.0, 3.7 + WALL_M), (1.35, 2.65), (1.3, 1.3 + WALL_M)),
         ),
     )
     return Scene("open_box", world, (0.5, 2.0, -1.0), (5.2, 2.0, -1.0),
@@ -108,15 +108,15 @@ def open_box_scene() -> Scene:
 
 
 def dead_end_scene() -> Scene:
-    """A dead end: a narrow roofed passage (0.9 m wide, 1.4 m high) closed at its far end."""
+    """A dead end: a narrow roofed passage (1 m long, 0.9 m wide, 1.4 m high), closed at the end."""
     h = (0.0, 1.4)
     world = World(
         ROOM,
         (
             _box("dead_end_wall", (3.6, 3.6 + WALL_M), (1.55, 2.45), h),
-            _box("dead_end_side_w", (2.0, 3.6), (1.55, 1.55 + WALL_M), h),
-            _box("dead_end_side_e", (2.0, 3.6), (2.45 - WALL_M, 2.45), h),
-            _box("dead_end_roof", (2.0, 3.6 + WALL_M), (1.55, 2.45), (1.4, 1.4 + WALL_M)),
+            _box("dead_end_side_w", (2.6, 3.6), (1.55, 1.55 + WALL_M), h),
+            _box("dead_end_side_e", (2.6, 3.6), (2.45 - WALL_M, 2.45), h),
+            _box("dead_end_roof", (2.6, 3.6 + WALL_M), (1.55, 2.45), (1.4, 1.4 + WALL_M)),
         ),
     )
     return Scene("dead_end", world, (0.5, 2.0, -1.0), (5.2, 2.0, -1.0),
