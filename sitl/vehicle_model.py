@@ -15,11 +15,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from sitl import physics
-from sitl.battery import BatteryState, battery_state, cell_ocv_v, state_of_charge
+from sitl.battery import (
+    BatteryState,
+    battery_state,
+    cell_ocv_v,
+    state_of_charge,
+    terminal_voltage_v,
+)
 from sitl.geometry import FLOOR, geometry
 from sitl.motors import clamp_throttle, throttle_for_fraction
 from sitl.params import GRAVITY_MPS2, VehicleParams, derived
-from sitl.rotation import Quat, Vec3, quat_to_euler, rotate_n_to_b
+from sitl.rotation import Quat, Vec3, quat_normalize, quat_to_euler, rotate_n_to_b
 from sitl.sensors.baro import BaroModel, BaroSample
 from sitl.sensors.imu import ImuModel, ImuSample
 from sitl.sensors.mocap import MocapModel, MocapSample
@@ -65,12 +71,14 @@ class SimVehicle:
         rng: np.random.Generator,
         noise: bool = True,
         start_hovering: bool = False,
+        battery_used_mah: float = 0.0,
     ) -> None:
         """Place the vehicle at start_pos_n (default: the world's first start position).
 
         A start at or below the resting height puts it on whatever is below, motors stopped.
         `start_hovering` spins the motors at hover speed, for tests that start in the air.
-        `params` defaults to the world's `[vehicle]` table.
+        `params` defaults to the world's `[vehicle]` table; `battery_used_mah` starts the
+        battery partly discharged.
         """
         self.world = world
         self.params = params if params is not None else world.vehicle
@@ -80,6 +88,14 @@ class SimVehicle:
         if len(pos) != 3 or not all(math.isfinite(float(v)) for v in pos):
             raise ValueError(f"start_pos_n: expected 3 finite numbers, got {pos!r}")
         self._core = physics.initial_core(self.params, world, pos, yaw_rad)
+        if not 0.0 <= battery_used_mah <= self.params.battery_capacity_mah:
+            raise ValueError(
+                f"battery_used_mah: expected 0..{self.params.battery_capacity_mah}, "
+                f"got {battery_used_mah!r}"
+            )
+        c0 = self._core
+        c0.used_mah = float(battery_used_mah)
+        c0.voltage_v = terminal_voltage_v(self.params, c0.used_mah, c0.current_a)
         self.t_s = 0.0
         s = world.sensors
         r_imu, r_sonar, r_baro, r_prox, r_rad, r_mocap = rng.spawn(6)
@@ -124,6 +140,29 @@ class SimVehicle:
             if mocap is not None and t >= mocap.next_capture_t_s - 1e-9:
                 mocap.capture(t, (c.x, c.y, c.z), (c.qw, c.qx, c.qy, c.qz))
         self.t_s = t0 + dt_s
+
+    def set_pose(
+        self,
+        pos_n: Sequence[float],
+        q_nb: Sequence[float] = (1.0, 0.0, 0.0, 0.0),
+        vel_n: Sequence[float] = (0.0, 0.0, 0.0),
+    ) -> None:
+        """Teleport: put the vehicle at pos_n with attitude q_nb and velocity vel_n (rates zero).
+
+        For tests and scenario resets; the next step() decides contact from the new pose.
+        """
+        vals = [float(v) for v in (*pos_n, *q_nb, *vel_n)]
+        if len(vals) != 10 or not all(math.isfinite(v) for v in vals):
+            raise ValueError("set_pose: expected pos_n (3), q_nb (4), vel_n (3) finite numbers")
+        c = self._core
+        c.x, c.y, c.z = vals[0:3]
+        c.qw, c.qx, c.qy, c.qz = quat_normalize(*vals[3:7])
+        c.vx, c.vy, c.vz = vals[7:10]
+        c.p = c.q = c.r = 0.0
+        rest_z = self._geom.support_z(c.x, c.y, c.z) - self.params.gear_height_m
+        c.on_ground = c.z >= rest_z
+        if c.on_ground:
+            c.z = rest_z
 
     # --- truth and power ----------------------------------------------------------------
 
