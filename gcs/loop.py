@@ -141,12 +141,11 @@ class FixedRateLoop:
 
     def stats(self) -> LoopStats:
         """A consistent snapshot of the timing statistics (thread-safe)."""
-        with self._lock:
-            periods = np.fromiter(self._periods, float)
-            jitters = np.fromiter(self._jitters, float)
-            computes = np.fromiter(self._computes, float)
-            lateness = np.fromiter(self._lateness, float)
+        with self._lock:  # copy fast under the lock; the loop thread must not wait on numpy
+            raw = (list(self._periods), list(self._jitters), list(self._computes),
+                   list(self._lateness))
             ticks, overruns, missed = self._ticks, self._overruns, self._missed
+        periods, jitters, computes, lateness = (np.asarray(a, dtype=float) for a in raw)
 
         def pct(a: np.ndarray, q: float) -> float:
             return float(np.percentile(a, q)) if a.size else 0.0

@@ -1,0 +1,216 @@
+"""The station's tick on a simulated clock, against an in-process stand-in for the APM board."""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import pytest
+
+from firmware_link.records import (
+    Attitude,
+    Dialect,
+    FlightMode,
+    Heartbeat,
+    Imu,
+    LinkEvent,
+    LinkEventKind,
+    Rangefinder,
+    RcCommand,
+    SimTruth,
+    SystemStatus,
+)
+from gcs import topics
+from gcs.clock import MonotonicClock, SimClock
+from gcs.estimation import GRAVITY_MPS2
+from gcs.station import ControlMode, EventLevel, Station
+from gcs.thrust_curve import ThrottleCurve
+
+
+class FakeBoard:
+    """A point-mass quadrotor behind an APM-2.5-like link (the one thing tests may mock)."""
+
+    def __init__(self, clock: SimClock, hover_true: float = 0.55) -> None:
+        self.clock = clock
+        self.curve = ThrottleCurve.for_dialect(Dialect.APM25)
+        self.hover_true = hover_true
+        self.h = 0.0
+        self.v = 0.0
+        self.t = clock.now_s()
+        self.cmd = RcCommand()
+        self.armed = False
+        self.lost = False
+        self.overrides: list[RcCommand] = []
+        self.released = 0
+        self.disarms: list[bool] = []
+        self.stats = {"rx_messages": 0}
+        self._k = 0
+        self.fail_poll = False
+
+    def _step_physics(self, now: float) -> None:
+        dt = now - self.t
+        self.t = now
+        if dt <= 0:
+            return
+        motor = self.curve.output(self.cmd.throttle_us) if self.armed else 0.0
+        a = GRAVITY_MPS2 * motor / self.hover_true - GRAVITY_MPS2
+        self.v += a * dt
+        self.h += self.v * dt
+        if self.h <= 0.0:
+            self.h, self.v = 0.0, max(self.v, 0.0)
+        self._a = a if self.h > 0 else 0.0
+
+    def poll(self) -> list[Any]:
+        if self.fail_poll:
+            raise OSError("serial port vanished")
+        now = self.clock.now_s()
+        self._step_physics(now)
+        if self.lost:
+            return []
+        self._k += 1
+        out: list[Any] = [
+            Attitude(now, 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            Imu(now, 1, (0.0, 0.0, -(GRAVITY_MPS2 + getattr(self, "_a", 0.0))), (0, 0, 0),
+                "RAW_IMU"),
+            SimTruth(now, 1, (0.0, 0.0, -self.h), (0.0, 0.0, -self.v), 0.0, 0.0, 0.0, "SIMSTATE"),
+        ]
+        if self._k % 2 == 0:
+            d = self.h + 0.001 * math.sin(self._k)  # keeps readings distinct
+            out.append(Rangefinder(now, 1, d if d >= 0.02 else 0.0, d >= 0.02, "RANGEFINDER"))
+        if self._k % 40 == 1:
+            out.append(Heartbeat(now, 1, 1, 0, self.armed, SystemStatus.STANDBY, 81))
+        return out
+
+    def rc_override(self, cmd: RcCommand) -> bool:
+        self.overrides.append(cmd)
+        self.cmd = cmd
+        return True
+
+    def release_overrides(self) -> bool:
+        self.released += 1
+        return True
+
+    def send_arm(self, force: bool = False) -> bool:
+        self.armed = self.cmd.throttle_us <= 1100
+        return True
+
+    def send_disarm(self, force: bool = False) -> bool:
+        self.disarms.append(force)
+        self.armed = False
+        return True
+
+    def send_set_mode(self, mode: FlightMode | int) -> bool:
+        return True
+
+
+class ListRecorder:
+    def __init__(self) -> None:
+        self.items: list[tuple[str, float, Any]] = []
+
+    def put(self, topic: str, t_s: float, payload: Any) -> None:
+        self.items.append((topic, t_s, payload))
+
+    def put_raw(self, direction: str, t_s: float, data: bytes) -> None:
+        self.items.append((f"raw/{direction}", t_s, data))
+
+
+def make(hover_true: float = 0.55) -> tuple[Station, FakeBoard, SimClock, ListRecorder]:
+    clock = SimClock(1000.0)
+    board = FakeBoard(clock, hover_true)
+    rec = ListRecorder()
+    st = Station(board, clock=clock, recorder=rec, curve=board.curve)
+    return st, board, clock, rec
+
+
+def run_s(st: Station, seconds: float) -> None:
+    st.loop.run(max_ticks=round(seconds / st.config.period_s))
+
+
+def test_takeoff_and_hold_from_the_floor_with_override_every_tick() -> None:
+    st, board, _clock, rec = make(hover_true=0.55)  # the station believes THR_MID 0.5
+    st.request_arm()
+    run_s(st, 0.5)
+    assert board.armed
+    st.alt_hold(True, 1.0, rate_mps=0.5)
+    run_s(st, 20.0)
+    assert board.h == pytest.approx(1.0, abs=0.02)
+    snap = st.snapshot()
+    assert snap.mode is ControlMode.ALT_HOLD and snap.alt_setpoint_m == pytest.approx(1.0)
+    assert len(board.overrides) == snap.loop.ticks  # one override per tick, never skipped
+    assert snap.hover_throttle > 0.5  # learning towards the true 0.55
+    names = {t for t, _, _ in rec.items}
+    for topic in (topics.ESTIMATE, topics.ALT_CONTROLLER, topics.RC_OVERRIDE, topics.LOOP,
+                  topics.IMU, topics.RANGEFINDER, topics.SIM_TRUTH, topics.EVENTS):
+        assert topic in names
+
+
+def test_link_loss_holds_last_command_then_reengages() -> None:
+    st, board, _clock, _ = make(hover_true=0.5)
+    st.request_arm()
+    run_s(st, 0.2)
+    st.alt_hold(True, 1.0)
+    run_s(st, 10.0)
+    board.lost = True
+    run_s(st, 0.5)
+    held = board.overrides[-1]
+    run_s(st, 1.0)
+    assert all(c == held for c in board.overrides[-40:])  # still sent every tick, unchanged
+    assert any("LOST" in e.text for e in st.snapshot().events)
+    board.lost = False
+    run_s(st, 10.0)
+    assert any("regained" in e.text for e in st.snapshot().events)
+    assert board.h == pytest.approx(1.0, abs=0.05)
+
+
+def test_kill_drops_throttle_and_disarms() -> None:
+    st, board, _clock, _ = make()
+    st.request_arm()
+    run_s(st, 0.2)
+    st.alt_hold(True, 1.0)
+    run_s(st, 5.0)
+    st.kill()
+    run_s(st, 0.1)
+    assert board.overrides[-1].throttle_us == 1000
+    assert board.disarms == [True]
+    assert st.snapshot().mode is ControlMode.KILLED
+    st.alt_hold(True, 1.0)  # ignored once killed
+    run_s(st, 0.1)
+    assert st.snapshot().mode is ControlMode.KILLED
+
+
+def test_manual_sticks_pass_through_clamped() -> None:
+    st, board, _clock, _ = make()
+    st.set_sticks(1400, 1600, 1500, 2500)
+    run_s(st, 0.05)
+    assert board.overrides[-1] == RcCommand(1400, 1600, 2000, 1500)
+
+
+def test_crash_in_the_loop_releases_overrides_and_reports() -> None:
+    clock = SimClock()
+    board = FakeBoard(clock)
+    st = Station(board, clock=MonotonicClock())
+    board.clock = clock
+    st.start()
+    assert st.wait_for(lambda s: s.tick >= 3, 5.0) is not None
+    board.fail_poll = True
+    deadline = time.monotonic() + 5.0
+    while st.running and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert not st.running
+    assert isinstance(st.error, OSError)
+    assert board.released == 1
+    assert any(e.level is EventLevel.ERROR and "serial port vanished" in e.text
+               for e in st.snapshot().events)
+
+
+def test_link_events_become_station_events() -> None:
+    st, board, clock, _ = make()
+    original = board.poll
+
+    def poll_with_event() -> list[Any]:
+        return [*original(), LinkEvent(clock.now_s(), 1, LinkEventKind.LOST, "no heartbeat")]
+
+    board.poll = poll_with_event  # type: ignore[method-assign]
+    run_s(st, 0.05)
+    assert any(e.text.startswith("link lost") for e in st.snapshot().events)
