@@ -201,7 +201,7 @@ def run_headless(
         while not player.finished:
             consume(player.due())
             wait = player.wait_s()
-            if wait > 0:
+            if wait > 0 and not player.finished:
                 sleep(min(wait, max_wait_s))
     print(tracker.status_line(player.duration_s), file=out)
     lines += 1

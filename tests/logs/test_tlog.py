@@ -1,0 +1,100 @@
+"""tlog import/export against the real ArduCopter 4.7 SITL flight, read back by pymavlink."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from gcs.cli import main
+from logs import RecordingError, open_recording
+from logs.tlog import export_tlog, read_tlog
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _pymavlink_digest(path: Path) -> dict:
+    proc = subprocess.run(
+        [sys.executable, "-m", "tests.logs.pymavlink_dump", str(path)],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    return json.loads(proc.stdout)
+
+
+@pytest.fixture(scope="module")
+def round_trip(tmp_path_factory) -> tuple[Path, Path, Path]:
+    from tests.logs.conftest import FLIGHT_TLOG
+
+    if not FLIGHT_TLOG.exists():
+        pytest.skip("fixture tlog not present")
+    d = tmp_path_factory.mktemp("tlog")
+    mcap = d / "imported.mcap"
+    out = d / "exported.tlog"
+    assert main(["logs", "import-tlog", str(FLIGHT_TLOG), "-o", str(mcap)]) == 0
+    assert main(["logs", "export", str(mcap), "--tlog", str(out)]) == 0
+    return FLIGHT_TLOG, mcap, out
+
+
+def test_import_splits_directions_by_gcs_sysid(round_trip) -> None:
+    src, mcap, _ = round_trip
+    rec = open_recording(mcap)
+    frames = list(read_tlog(src))
+    tx = sum(1 for f in frames if f.sysid == 255)
+    assert rec.counts == {"/mavlink/rx": len(frames) - tx, "/mavlink/tx": tx}
+    assert rec.counts == {"/mavlink/rx": 74094, "/mavlink/tx": 8521}  # as ECOSYSTEM.md measured
+    assert rec.duration_s == pytest.approx(257.06, abs=0.01)
+    assert rec.metadata["imported_from"] == src.name
+
+
+def test_export_is_byte_identical_to_the_source(round_trip) -> None:
+    src, _, out = round_trip
+    assert out.read_bytes() == src.read_bytes()
+
+
+def test_pymavlink_reads_the_export_as_the_source(round_trip) -> None:
+    src, _, out = round_trip
+    a = _pymavlink_digest(src)
+    b = _pymavlink_digest(out)
+    assert a["count"] > 80_000
+    assert a == b
+    assert {"HEARTBEAT", "ATTITUDE", "RC_CHANNELS_OVERRIDE"} <= set(a["types"])
+
+
+def test_export_of_a_live_recording_keeps_time_order(recorded_flight, tmp_path) -> None:
+    path, counts = recorded_flight
+    n = export_tlog(open_recording(path), tmp_path / "live.tlog")
+    assert n == counts["/mavlink/rx"] + counts["/mavlink/tx"]
+    frames = list(read_tlog(tmp_path / "live.tlog"))
+    assert len(frames) == n
+    stamps = [f.t_us for f in frames]
+    assert stamps == sorted(stamps)
+    assert {f.sysid for f in frames} == {1, 255}
+
+
+def test_torn_last_frame_is_left_out_and_garbage_is_an_error(flight_tlog, tmp_path) -> None:
+    data = flight_tlog.read_bytes()
+    torn = tmp_path / "torn.tlog"
+    torn.write_bytes(data[:1000])
+    frames = list(read_tlog(torn))
+    assert 0 < len(frames) < 50
+    assert all(f.data[0] == 0xFD for f in frames)
+    bad = tmp_path / "bad.tlog"
+    bad.write_bytes(b"\x00" * 8 + b"hello world, not mavlink")
+    with pytest.raises(RecordingError, match="not a tlog"):
+        list(read_tlog(bad))
+
+
+def test_export_without_raw_frames_is_refused(tmp_path) -> None:
+    from logs import Recorder
+
+    with Recorder(tmp_path / "r.mcap", metadata={}) as rec:
+        rec.put("/x", 1.0, {"a": 1})
+    with pytest.raises(RecordingError, match="no raw MAVLink frames"):
+        export_tlog(open_recording(rec.path), tmp_path / "x.tlog")
