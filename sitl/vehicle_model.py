@@ -108,6 +108,9 @@ class SimVehicle:
         self._prox = ProximityModel(s.proximity, r_prox, noise)
         self._rad = RadiationModel(world.sources, world.background_cps, s.radiation, r_rad, noise)
         self._mocap = MocapModel(s.mocap, r_mocap, noise) if world.mocap_enabled else None
+        if self._mocap is not None:
+            c = self._core
+            self._mocap.capture(0.0, (c.x, c.y, c.z), (c.qw, c.qx, c.qy, c.qz))
         if start_hovering:
             omega, volts, amps = self._hover_point()
             c = self._core

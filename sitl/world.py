@@ -11,7 +11,7 @@ on the floor, because heights are what people measure; the loader converts them 
     [[sources]]  name = "...", position = [x, y, z_up], strength_cps = 5000.0  # counts/s at 1 m
     [radiation]  background_cps = 50.0    # default: 1 % of the strongest source
     [mocap]      enabled = true
-    start_positions = [[x, y], [x, y, z_up], ...]   # z_up omitted: resting on what is below
+    start_positions = [[x, y], [x, y, z_up], ...]   # no z_up: on top of what stands there
     [origin]     lat_deg = ..., lon_deg = ..., alt_amsl_m = ...
     [sensors.imu] / [sensors.sonar] / ... overrides (see sitl.sensor_params)
     [vehicle]    overrides of sitl.params.VehicleParams
@@ -243,6 +243,10 @@ def _inside_room(p: Vec3, room: tuple[Vec3, Vec3]) -> bool:
     return all(rmin[i] <= p[i] <= rmax[i] for i in range(3))
 
 
+def _over_box(x: float, y: float, b: Box) -> bool:
+    return b.min_n[0] <= x <= b.max_n[0] and b.min_n[1] <= y <= b.max_n[1]
+
+
 def _inside_box(p: Vec3, b: Box) -> bool:
     return all(b.min_n[i] < p[i] < b.max_n[i] for i in range(3))
 
@@ -291,9 +295,16 @@ def world_from_toml(data: Mapping[str, Any]) -> World:
     starts: list[Vec3] = []
     for i, s in enumerate(starts_raw):
         where = f"start_positions[{i}]"
-        n = len(s) if isinstance(s, list) else 0
-        p = _numbers(s, 3 if n == 3 else 2, where)
-        pos = _up_to_ned(p if len(p) == 3 else (p[0], p[1], 0.0))
+        n = len(s) if isinstance(s, list) else -1
+        if n not in (2, 3):
+            got = f"{n} numbers" if n >= 0 else type(s).__name__
+            raise ParamError(f"{where}: expected [x, y] or [x, y, z_up], got {got}")
+        p = _numbers(s, n, where)
+        if len(p) == 3:
+            pos = _up_to_ned(p)
+        else:  # on top of whatever stands there, else on the floor
+            tops = [b.min_n[2] for b in boxes if _over_box(p[0], p[1], b)]
+            pos = (p[0], p[1], min(tops, default=room[1][2]))
         if not _inside_room(pos, room):
             raise ParamError(f"{where}: outside the room")
         for b in boxes:
