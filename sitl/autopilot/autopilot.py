@@ -31,6 +31,7 @@ FORCE_ARM_MAGIC = 2989.0
 FORCE_DISARM_MAGIC = 21196.0
 STICK_DZ_US = 30  # RCn_DZ for roll/pitch
 YAW_DZ_US = 40
+GYRO_CAL_S = 1.0  # boot-time gyro calibration; arming is refused until it is done
 AUTO_DISARM_S = {Profile.APM25: 15.0, Profile.COPTER4: 10.0}
 SPIN_ARMED = {Profile.APM25: 0.07, Profile.COPTER4: 0.10}  # MOT_SPIN_ARMED 70 / MOT_SPIN_ARM
 
@@ -119,6 +120,9 @@ class Autopilot:
         self._t_s = 0.0
         self._zero_throttle_s = 0.0
         self._last_throttle = 0.0
+        self._cal_sum = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        self._cal_n = 0
+        self.calibrated = False
         self._refresh_gains()
 
     # ---- parameters ------------------------------------------------------------------------
@@ -196,6 +200,8 @@ class Autopilot:
         if self.state.armed:
             return CommandResult(True)
         forced = self.profile is Profile.COPTER4 and force == FORCE_ARM_MAGIC
+        if not self.calibrated:
+            return CommandResult(False, "PreArm: Gyros not calibrated")
         if not forced:
             if self.profile is Profile.COPTER4 and self.state.mode is FlightMode.LAND:
                 return CommandResult(False, "Arm: Mode not armable")
@@ -232,6 +238,8 @@ class Autopilot:
         self._refresh_gains()
         st = self.state
         g = self.gains
+        if not self.calibrated:
+            self._calibrate(s, t_s)
         self.ahrs.update(s.gyro_b, s.acc_b, dt_s)
         roll, pitch, yaw = self.ahrs.euler()
         st.roll_rad, st.pitch_rad, st.yaw_rad = roll, pitch, yaw
@@ -278,6 +286,25 @@ class Autopilot:
         st.target_alt_m = self.alt_ctrl.target_alt_cm / 100.0
         self._post_tick(throttle, dt_s)
         return out
+
+    def _calibrate(self, s: SensorSample, t_s: float) -> None:
+        for i in range(3):
+            self._cal_sum[i] += s.gyro_b[i]
+            self._cal_sum[3 + i] += s.acc_b[i]
+        self._cal_n += 1
+        if t_s + 1e-9 >= GYRO_CAL_S:
+            n = float(self._cal_n)
+            self.ahrs.set_gyro_offsets(
+                (self._cal_sum[0] / n, self._cal_sum[1] / n, self._cal_sum[2] / n)
+            )
+            self.ahrs.level_from(
+                (self._cal_sum[3] / n, self._cal_sum[4] / n, self._cal_sum[5] / n), 0.0
+            )
+            mean_acc = (self._cal_sum[3] / n, self._cal_sum[4] / n, self._cal_sum[5] / n)
+            # the owner's accelerometer calibration: the vertical offset seen at rest
+            self.inav.set_accel_offset(math.sqrt(sum(a * a for a in mean_acc)) - GRAVITY_MSS)
+            self.calibrated = True
+            self.texts.append((Severity.INFO, "Calibrating barometer"))
 
     def _run_mode(
         self, dt_s: float, acc_up: float, tilt_cos: float

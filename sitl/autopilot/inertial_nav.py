@@ -34,6 +34,10 @@ class InertialNavZ:
         self._history.clear()
         self._initialised = True
 
+    def set_accel_offset(self, acc_up_bias_mss: float) -> None:
+        """Start the filter's accelerometer correction from a bias measured at rest."""
+        self._acc_corr = -acc_up_bias_mss
+
     def correct(self, measured_alt_m: float) -> None:
         """Record an altitude measurement's error against the delayed estimate."""
         if not self._initialised:

@@ -1,0 +1,182 @@
+"""`python -m sitl` / `quadgcs sitl`: run the bundled SITL behind MAVLink endpoints.
+
+Stdout contract (a station parses it): one line per endpoint
+`vehicle <sysid> tcp:127.0.0.1:<port>` / `vehicle <sysid> serial:<pty>` /
+`vehicle <sysid> udp:<host>:<port>`, then `mocap tcp:127.0.0.1:<port>` when motion capture is
+on, then `ready`. Everything else goes to stderr. SIGINT/SIGTERM end it cleanly (exit 0).
+Expected errors end in one line on stderr: exit 2 for bad input, 1 for run-time failures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from collections.abc import Sequence
+from types import FrameType
+
+from sitl.autopilot import Profile
+from sitl.link.codec import SigningKeyError, load_signing_key
+from sitl.link.endpoints import EndpointError
+from sitl.link.server import TCP_BASE_PORT, EndpointPlan, SitlServer
+from sitl.simulation import Simulation
+from sitl.world import WorldError, default_world, load_world
+
+MOCAP_DEFAULT_PORT = 5750
+MAX_VEHICLES = 20
+
+
+class CliError(Exception):
+    """One-line error with an exit code."""
+
+    def __init__(self, message: str, exit_code: int) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number 0..65535, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port number 0..65535, got {value}")
+    return value
+
+
+def _host_port(text: str) -> tuple[str, int]:
+    host, sep, port = text.rpartition(":")
+    if not sep or not host:
+        raise argparse.ArgumentTypeError(f"expected HOST:PORT, got {text!r}")
+    p = _port(port)
+    if p == 0:
+        raise argparse.ArgumentTypeError(f"expected a UDP port 1..65535, got {text!r}")
+    return host, p
+
+
+def _positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
+    if not value > 0.0 or value != value:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
+def _vehicles(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected 1..{MAX_VEHICLES}, got {text!r}") from None
+    if not 1 <= value <= MAX_VEHICLES:
+        raise argparse.ArgumentTypeError(f"expected 1..{MAX_VEHICLES}, got {value}")
+    return value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The SITL's flags (shared with `quadgcs sitl`)."""
+    parser.add_argument("--world", metavar="FILE", help="world TOML file (default: empty room)")
+    parser.add_argument(
+        "--tcp",
+        type=_port,
+        default=TCP_BASE_PORT,
+        metavar="PORT",
+        help="TCP port of vehicle 1; vehicle i gets PORT+10*(i-1); 0 = OS-chosen (default 5760)",
+    )
+    parser.add_argument(
+        "--udp", type=_host_port, metavar="HOST:PORT", help="also send MAVLink to HOST:PORT (UDP)"
+    )
+    parser.add_argument(
+        "--serial", action="store_true", help="also open a pseudo-terminal serial port (115200)"
+    )
+    parser.add_argument("--vehicles", type=_vehicles, default=1, metavar="N")
+    parser.add_argument("--speedup", type=_positive, default=1.0, metavar="K")
+    parser.add_argument(
+        "--profile", choices=[p.value for p in Profile], default=Profile.APM25.value
+    )
+    parser.add_argument("--seed", type=int, default=0, metavar="N")
+    parser.add_argument(
+        "--signing-key", metavar="FILE", help="MAVLink 2 signing key (copter4 only)"
+    )
+    parser.add_argument("--no-noise", action="store_true", help="perfect sensors (tests only)")
+    parser.add_argument(
+        "--mocap-port",
+        type=_port,
+        metavar="PORT",
+        help="motion-capture TCP port when the world has it on (default 5750; OS-chosen with "
+        "--tcp 0)",
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Parser of `python -m sitl`."""
+    parser = argparse.ArgumentParser(
+        prog="python -m sitl", description="Simulated ArduCopter quadrotors speaking MAVLink."
+    )
+    add_arguments(parser)
+    return parser
+
+
+def _server_from_args(args: argparse.Namespace) -> SitlServer:
+    profile = Profile(args.profile)
+    try:
+        world = load_world(args.world) if args.world else default_world()
+    except WorldError as exc:
+        raise CliError(str(exc), 2) from None
+    key = None
+    if args.signing_key:
+        if profile is not Profile.COPTER4:
+            raise CliError("--signing-key: signing needs --profile copter4 (MAVLink 2)", 2)
+        try:
+            key = load_signing_key(args.signing_key)
+        except SigningKeyError as exc:
+            raise CliError(str(exc), 2) from None
+    sim = Simulation(
+        world, profile, args.vehicles, seed=args.seed, noise=not args.no_noise, signing_key=key
+    )
+    mocap_port = None
+    if world.mocap_enabled:
+        if args.mocap_port is not None:
+            mocap_port = args.mocap_port
+        else:
+            mocap_port = 0 if args.tcp == 0 else MOCAP_DEFAULT_PORT
+    plan = EndpointPlan(tcp_port=args.tcp, udp=args.udp, serial=args.serial, mocap_port=mocap_port)
+    try:
+        return SitlServer(sim, plan, speedup=args.speedup)
+    except EndpointError as exc:
+        raise CliError(f"cannot open endpoint: {exc.strerror}", 1) from None
+
+
+def run(args: argparse.Namespace) -> int:
+    """Start, print the endpoint lines and `ready`, serve until a signal."""
+    try:
+        server = _server_from_args(args)
+    except CliError as exc:
+        print(f"sitl: {exc}", file=sys.stderr, flush=True)
+        return exc.exit_code
+
+    def _on_signal(_sig: int, _frame: FrameType | None) -> None:
+        server.stop()
+
+    previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        for line in server.address_lines():
+            print(line, flush=True)
+        print("ready", flush=True)
+        server.run()
+    finally:
+        server.close()
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    print(
+        f"sitl: stopped at t={server.sim.t_s:.1f} s ({server.resyncs} clock resyncs)",
+        file=sys.stderr,
+        flush=True,
+    )
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of `python -m sitl`."""
+    return run(build_parser().parse_args(argv))
