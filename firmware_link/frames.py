@@ -74,12 +74,18 @@ class FrameEndpoint:
         """The pymavlink object whose `*_encode` methods build outgoing messages."""
         return self._encoder_v1 if self.wire is WireVersion.V1 else self.parser
 
-    def set_signing(self, key: bytes | None, *, link_id: int, timestamp: int) -> None:
-        """Sign every outgoing frame and refuse unsigned ones (key None: stop signing)."""
+    def set_signing(
+        self, key: bytes | None, *, link_id: int, timestamp: int, accept_unsigned: bool = False
+    ) -> None:
+        """Sign every outgoing frame and refuse unsigned ones (key None: stop signing).
+
+        `accept_unsigned` lets unsigned frames through while the peer's firmware is still
+        being found out; it is switched off once the vehicle is known to sign.
+        """
         signing = self.parser.signing
         signing.secret_key = key
         signing.sign_outgoing = key is not None
-        signing.allow_unsigned_callback = None
+        signing.allow_unsigned_callback = (lambda _mav, _msgid: True) if accept_unsigned else None
         signing.link_id = link_id
         signing.timestamp = max(signing.timestamp, timestamp)
 

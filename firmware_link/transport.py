@@ -11,6 +11,7 @@ import contextlib
 import errno
 import select
 import socket
+import time
 from typing import Protocol
 
 import serial
@@ -68,7 +69,8 @@ class TcpTransport:
     @classmethod
     def _ready(cls, spec: ConnectionSpec, sock: socket.socket) -> TcpTransport:
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        sock.settimeout(WRITE_TIMEOUT_S)
+        # Non-blocking: a socket timeout would make recv() wait for it before giving up.
+        sock.setblocking(False)
         return cls(spec, sock)
 
     @classmethod
@@ -104,7 +106,7 @@ class TcpTransport:
         chunks = []
         while True:
             try:
-                data = self._sock.recv(READ_CHUNK_BYTES, socket.MSG_DONTWAIT)
+                data = self._sock.recv(READ_CHUNK_BYTES)
             except (BlockingIOError, InterruptedError):
                 break
             except OSError as exc:
@@ -120,10 +122,20 @@ class TcpTransport:
 
     def write(self, data: bytes) -> None:
         """Send all of `data`; raises TransportClosed if the peer is gone."""
-        try:
-            self._sock.sendall(data)
-        except OSError as exc:
-            raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
+        view = memoryview(data)
+        deadline = time.monotonic() + WRITE_TIMEOUT_S
+        while view:
+            try:
+                sent = self._sock.send(view)
+            except (BlockingIOError, InterruptedError):
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise TransportClosed(f"{self.spec.url}: peer stopped reading") from None
+                select.select([], [self._sock], [], remaining)
+                continue
+            except OSError as exc:
+                raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
+            view = view[sent:]
 
     def wait_readable(self, timeout_s: float) -> None:
         """Block until bytes arrive or `timeout_s` passes."""

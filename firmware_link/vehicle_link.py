@@ -23,7 +23,7 @@ from firmware_link.convert import RecordConverter, text_field
 from firmware_link.dialect import APM25_CANNOT_SIGN, DIALECT_TEXT, DIALECT_WIRE, dialect_of_frame
 from firmware_link.errors import LinkError, LinkUsageError
 from firmware_link.frames import FrameEndpoint, RawTap
-from firmware_link.protocol import message_id
+from firmware_link.protocol import WireVersion, message_id
 from firmware_link.records import (
     CommandAck,
     Dialect,
@@ -73,6 +73,7 @@ RC_MIN_US = 1000
 RC_MAX_US = 2000
 RC_RELEASE = 0
 RC_LEAVE_ALONE = 65535
+SIGNING_ON = "MAVLink 2 signing on: outgoing frames signed, unsigned frames refused"
 
 
 class MavResult:
@@ -173,6 +174,16 @@ class VehicleLink:
             on_raw=on_raw,
         )
         link = cls(spec, endpoint, clock=clock, wall_clock=wall_clock, signing_key=signing_key)
+        if signing_key is not None:
+            # Only MAVLink 2 can sign: greet signed, but hear unsigned frames until the
+            # firmware is known (an APM 2.5 must be told plainly that it cannot sign).
+            endpoint.wire = WireVersion.V2
+            endpoint.set_signing(
+                signing_key,
+                link_id=0,
+                timestamp=signing_timestamp(wall_clock()),
+                accept_unsigned=True,
+            )
         try:
             link._await_vehicle(target_system, wait_heartbeat_s, install_signing_key)
         except BaseException:
@@ -215,10 +226,10 @@ class VehicleLink:
         self._ep.wire = DIALECT_WIRE[self._dialect]
         self._event(now, LinkEventKind.CONNECTED, f"{self.spec.url}: vehicle {self._target_system}")
         self._event(now, LinkEventKind.DIALECT, DIALECT_TEXT[self._dialect])
-        self._setup_signing(deadline, install_key)
+        self._setup_signing(deadline, install_key, bool(getattr(first, "_signed", False)))
         self._dispatch(first, now)
 
-    def _setup_signing(self, deadline: float, install_key: bool) -> None:
+    def _setup_signing(self, deadline: float, install_key: bool, first_signed: bool) -> None:
         now = self._clock()
         key = self._signing_key
         if self._dialect is Dialect.APM25:
@@ -239,6 +250,9 @@ class VehicleLink:
             self._send(msg)
         self._ep.set_signing(key, link_id=0, timestamp=timestamp)
         self._signing = True
+        if first_signed:
+            self._event(now, LinkEventKind.SIGNING, SIGNING_ON)
+            return
         # The vehicle must now speak signed: wait for one signed heartbeat.
         refused_before = self._ep.tally.signature_refusals
         while True:
@@ -256,9 +270,7 @@ class VehicleLink:
                 raise LinkError(f"{self.spec.url}: the peer closed the link") from None
             for msg in msgs:
                 if msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == self._target_system:
-                    self._event(
-                        now, LinkEventKind.SIGNING, "MAVLink 2 signing on: unsigned frames refused"
-                    )
+                    self._event(now, LinkEventKind.SIGNING, SIGNING_ON)
                     return
 
     # ------------------------------------------------------------------ properties

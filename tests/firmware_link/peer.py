@@ -77,8 +77,6 @@ class FakeVehicle:
         self._client: socket.socket | None = None
         self._master = -1
         self.url = ""
-        self.accepting = threading.Event()
-        self.accepting.set()
         if serial:
             self._master, slave = os.openpty()
             tty.setraw(slave)
@@ -86,6 +84,7 @@ class FakeVehicle:
             self._slave = slave
         else:
             self._server = socket.socket()
+            self._server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             self._server.bind(("127.0.0.1", 0))
             self._server.listen(4)
             self.port = self._server.getsockname()[1]
@@ -107,14 +106,24 @@ class FakeVehicle:
             os.close(self._master)
             os.close(self._slave)
 
-    def drop_client(self, refuse: bool = True) -> None:
-        """Close the TCP connection (as a SITL that died) and optionally stop accepting."""
-        if refuse:
-            self.accepting.clear()
+    def crash(self) -> None:
+        """Vanish as a SITL that died: close the connection and the listening port."""
+        self.paused.set()
         with self._lock:
-            if self._client is not None:
-                self._client.close()
-                self._client = None
+            for s in (self._client, self._server):
+                if s is not None:
+                    s.close()
+            self._client = self._server = None
+
+    def restart(self) -> None:
+        """Listen again on the same port and speak again."""
+        server = socket.socket()
+        server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        server.bind(("127.0.0.1", self.port))
+        server.listen(4)
+        with self._lock:
+            self._server = server
+        self.paused.clear()
 
     def inject(self, data: bytes) -> None:
         """Write raw bytes to the station (garbage, foreign frames)."""
@@ -148,12 +157,8 @@ class FakeVehicle:
     def _fds(self) -> list[int]:
         if self._master >= 0:
             return [self._master]
-        out = []
-        if self._server is not None and self._client is None and self.accepting.is_set():
-            out.append(self._server.fileno())
-        if self._client is not None:
-            out.append(self._client.fileno())
-        return out
+        with self._lock:
+            return [s.fileno() for s in (self._server, self._client) if s is not None]
 
     def _run(self) -> None:
         next_hb = 0.0
@@ -162,19 +167,34 @@ class FakeVehicle:
         t0 = time.monotonic()
         while not self._stop.is_set():
             fds = self._fds()
-            readable = select.select(fds, [], [], 0.001)[0] if fds else []
+            try:
+                readable = select.select(fds, [], [], 0.001)[0] if fds else []
+            except (OSError, ValueError):
+                continue  # a socket closed under us by crash()
             if not fds:
                 time.sleep(0.005)
             for fd in readable:
-                if self._server is not None and fd == self._server.fileno():
-                    client, _ = self._server.accept()
+                with self._lock:
+                    server, client = self._server, self._client
+                if server is not None and fd == server.fileno():
+                    try:
+                        client, _ = server.accept()
+                    except OSError:
+                        continue
                     client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
                     with self._lock:
+                        if self._client is not None:
+                            self._client.close()
                         self._client = client
                     next_hb = 0.0  # greet a new station at once
                     continue
                 try:
-                    data = os.read(fd, 4096) if self._master >= 0 else self._client.recv(4096)
+                    if self._master >= 0:
+                        data = os.read(fd, 4096)
+                    elif client is not None and fd == client.fileno():
+                        data = client.recv(4096)
+                    else:
+                        continue
                 except OSError:
                     data = b""
                 if not data:
