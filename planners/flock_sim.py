@@ -20,9 +20,9 @@ import numpy as np
 
 from planners.flock_scenes import FlockScene
 from planners.flocking import FlockMission, FlockParams, FlockPlanner
-from planners.geometry import Vec3
+from planners.geometry import Vec3, World
 from planners.kinematic import KinematicParams, KinematicSim
-from planners.proximity import ProximityParams, ProximityReading
+from planners.proximity import ProximityParams, ProximityReading, sense
 from planners.result import PlanStatus
 
 
@@ -129,6 +129,7 @@ class FlockResult:
     formation_error_m: float | None
     gate_crossings_s: tuple[float, ...]
     paths_n: dict[int, np.ndarray]
+    track_n: np.ndarray  # (steps + 1, n_vehicles, 3): every vehicle's position at every step
 
     @property
     def collisions(self) -> int:
@@ -184,6 +185,15 @@ def _pairwise_min(prev: np.ndarray, new: np.ndarray) -> float:
     return best
 
 
+def _sense_near(
+    scene: FlockScene, sim: KinematicSim, prm: FlockRunParams, rng: np.random.Generator
+) -> ProximityReading:
+    """The six IR readings, ray-casting only obstacles that could be inside sensor range."""
+    reach = prm.proximity.range_m + 1e-6
+    near = tuple(b for b in scene.world.obstacles if b.distance_to_point(sim.pos_n) <= reach)
+    return sense(World(scene.world.room, near), sim.pos_n, sim.yaw_rad, prm.proximity, rng)
+
+
 def run_flock(
     scene: FlockScene,
     n_vehicles: int,
@@ -225,9 +235,10 @@ def run_flock(
     crossings: list[float] = []
     crossed: set[int] = set()
     steps_run = 0
+    track = [prev]
     for step in range(max_steps):
         positions = {v: sims[v].pos_n for v in ids}
-        readings = {v: sims[v].sense() for v in ids}
+        readings = {v: _sense_near(scene, sims[v], prm, rng) for v in ids}
         out = plan.step(step, positions, readings)
         messages += out.messages_sent
         for e in out.formation_samples:
@@ -256,6 +267,7 @@ def run_flock(
                     crossed.add(v)
                     crossings.append((step + 1) * prm.dt_s)
         prev = new
+        track.append(new)
         steps_run = step + 1
         arrived = plan.arrived()
         for v in ids:
@@ -287,4 +299,5 @@ def run_flock(
         formation_error_m=math.sqrt(err_sq / err_n) if err_n else None,
         gate_crossings_s=tuple(crossings),
         paths_n={v: np.array(sims[v].path) for v in ids},
+        track_n=np.stack(track),
     )

@@ -152,6 +152,7 @@ class _State:
     avoid_dir: Vec3 | None = None
     overshoot: int = 0
     arrived_common: bool = False
+    individual: bool = False  # flying its individual goal (Algorithm 9.3.4)
     arrived_final: bool = False
     make_way_from: list[Vec3] = field(default_factory=list)  # where higher-priority ones wanted
 
@@ -248,12 +249,11 @@ class FlockPlanner:
         leader_avoiding = False
         samples = self._formation_samples(pos)  # type: ignore[arg-type]
 
-        if self.phase is Phase.COMMON_GOAL:
-            self._maybe_start_individual(pos)  # type: ignore[arg-type]
+        self._maybe_start_individual(pos)  # type: ignore[arg-type]
 
         for k in range(self.n):
             p: Vec3 = pos[k]  # type: ignore[assignment]
-            if self.phase is Phase.INDIVIDUAL_GOALS:
+            if self._states[k].individual:
                 sp, mode = self._individual(k, p, rd[k], reserved)
                 avoiding = mode is VehicleMode.AVOIDING
             elif k == 0:
@@ -275,7 +275,7 @@ class FlockPlanner:
                 sp = self._make_way(k, p, sp, rd[k], reserved)
             reserved[k] = sp
             modes[self.ids[k]] = mode
-            if self.phase is Phase.COMMON_GOAL:
+            if not self._states[k].individual:
                 sent += self.channel.offer(
                     step_index, k, self.formation.children(k), sp, avoiding
                 )
@@ -507,7 +507,9 @@ class FlockPlanner:
         dz = self._layer_offset_m(k) if st.trail_layer_on else 0.0
         while True:
             q = st.trail[min(st.trail_idx, len(st.trail) - 1)]
-            target = (q[0], q[1], q[2] + dz)
+            # Layers sit round the cruise altitude, not round a trail that may itself be layered.
+            z = self.mission.common_goal_n[2] + dz if st.trail_layer_on else q[2]
+            target = (q[0], q[1], z)
             if _dist(p, target) > prm.step_m * 0.5 or st.trail_idx >= len(st.trail) - 1:
                 break
             st.trail_idx += 1
@@ -529,21 +531,36 @@ class FlockPlanner:
         closest = a + t[:, None] * ab
         return bool(np.min(np.linalg.norm(pts - closest, axis=1)) >= self.params.rejoin_margin_m)
 
+    def _settled(self, k: int, p: Vec3) -> bool:
+        st = self._states[k]
+        return (
+            st.goal_n is not None
+            and not st.in_trail
+            and _dist(p, st.goal_n) <= self.params.goal_tolerance_m
+        )
+
     def _maybe_start_individual(self, pos: list[Vec3]) -> None:
+        """Once the root holds the common goal, each vehicle settled in its slot goes individual.
+
+        The root itself leaves when its whole team has settled, or after ``common_wait_steps``;
+        vehicles still queueing on a trail keep following it until they settle.
+        """
         root = self._states[0]
         if not root.arrived_common:
             return
         self._wait_at_common += 1
-        settled = all(
-            self._states[k].goal_n is not None
-            and _dist(pos[k], self._states[k].goal_n) <= self.params.goal_tolerance_m  # type: ignore[arg-type]
-            for k in range(1, self.n)
-        )
-        if settled or self._wait_at_common >= self.params.common_wait_steps:
-            self.phase = Phase.INDIVIDUAL_GOALS
-            for st in self._states:
+        for k in range(1, self.n):
+            st = self._states[k]
+            if not st.individual and self._settled(k, pos[k]):
+                st.individual = True
                 st.avoid_dir = None
-                st.in_trail = False
+        team_settled = all(self._states[k].individual for k in range(1, self.n))
+        if not root.individual and (
+            team_settled or self._wait_at_common >= self.params.common_wait_steps
+        ):
+            root.individual = True
+            root.avoid_dir = None
+            self.phase = Phase.INDIVIDUAL_GOALS
 
     def _individual(
         self, k: int, p: Vec3, reading: ProximityReading, reserved: list[Vec3]

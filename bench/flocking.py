@@ -1,0 +1,56 @@
+"""Triangular leader–follower flock vs the Reynolds baseline, kinematic mode, 5/15/31 vehicles.
+
+Prints one row per (scene, team size, planner): time to goal of the root leader and of the
+followers (mean / last), formation error, minimum separation, collisions, messages, throughput
+through the door, and how the run ended. Run: ``.venv/bin/python bench/flocking.py [sizes...]``.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+
+import numpy as np
+
+from planners.flock_scenes import all_scenes
+from planners.flock_sim import FlockPlannerKind, FlockResult, run_flock
+
+MAX_STEPS = 1200
+SEED = 7
+
+
+def _fmt(x: float | None, spec: str = ".1f") -> str:
+    return "-" if x is None else format(x, spec)
+
+
+def _row(r: FlockResult, wall_s: float) -> str:
+    fol = [t for t in r.follower_times_s if t is not None]
+    fol_mean = statistics.fmean(fol) if fol else None
+    fol_last = max(fol) if len(fol) == len(r.follower_times_s) and fol else None
+    return (
+        f"{r.scene:6} {r.n_vehicles:3d} {r.planner:10} {_fmt(r.leader_time_s):>7} "
+        f"{_fmt(fol_mean):>7} {_fmt(fol_last):>7} {_fmt(r.formation_error_m, '.2f'):>6} "
+        f"{r.min_separation_m:6.2f} {r.obstacle_collisions:4d} {r.vehicle_collisions:4d} "
+        f"{r.messages_sent:8d} {_fmt(r.throughput_vps, '.2f'):>6}  "
+        f"{r.status.value}: {r.reason} [{wall_s:.1f} s]"
+    )
+
+
+def main(argv: list[str]) -> None:
+    """Run every scene, size and planner; print the table."""
+    sizes = [int(a) for a in argv] or [5, 15, 31]
+    print(
+        "scene    N planner     lead_s  fol_s  fol_last  ferr_m  minsep  obsC  vehC"
+        "  messages  veh/s  status"
+    )
+    for n in sizes:
+        for scene in all_scenes():
+            for kind in FlockPlannerKind:
+                t0 = time.perf_counter()
+                r = run_flock(scene, n, kind, MAX_STEPS, np.random.default_rng(SEED))
+                print(_row(r, time.perf_counter() - t0), flush=True)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
