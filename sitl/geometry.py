@@ -26,13 +26,14 @@ BoxT = tuple[float, float, float, float, float, float, str]
 class Geometry:
     """Fast queries on one world's solids."""
 
-    __slots__ = ("boxes", "floor_z", "rx0", "rx1", "ry0", "ry1", "rz0", "rz1")
+    __slots__ = ("box_by_name", "boxes", "floor_z", "rx0", "rx1", "ry0", "ry1", "rz0", "rz1")
 
     def __init__(self, world: World) -> None:
         self.rx0, self.ry0, self.rz0 = world.room_min_n
         self.rx1, self.ry1, self.rz1 = world.room_max_n
         self.floor_z = self.rz1
         self.boxes: tuple[BoxT, ...] = tuple((*b.min_n, *b.max_n, b.name) for b in world.boxes)
+        self.box_by_name = {b[6]: b for b in self.boxes}
 
     def support_z(self, x: float, y: float, z: float) -> float:
         """NED z of the surface the vehicle would rest on below (x, y, z): floor or a box top."""
@@ -63,6 +64,45 @@ class Geometry:
             if dx * dx + dy * dy < r2:
                 return name
         return None
+
+    def contact_normal(
+        self, name: str, old: tuple[float, float, float], new: tuple[float, float, float], h: float
+    ) -> tuple[float, float, float]:
+        """Unit normal of solid `name` at a contact, pointing from the solid toward the vehicle.
+
+        `old` is the last clear position, `new` the touching one, h the body's half-height.
+        """
+        if name == WALL_NORTH:
+            return (-1.0, 0.0, 0.0)
+        if name == WALL_SOUTH:
+            return (1.0, 0.0, 0.0)
+        if name == WALL_EAST:
+            return (0.0, -1.0, 0.0)
+        if name == WALL_WEST:
+            return (0.0, 1.0, 0.0)
+        if name == CEILING:
+            return (0.0, 0.0, 1.0)
+        x0, y0, z0, x1, y1, z1, _ = self.box_by_name[name]
+        oz = old[2]
+        if oz + h <= z0:  # came down onto the top face
+            return (0.0, 0.0, -1.0)
+        if oz - h >= z1:  # came up under the bottom face
+            return (0.0, 0.0, 1.0)
+        x, y, _ = new
+        dx = x - (x0 if x < x0 else (x1 if x > x1 else x))
+        dy = y - (y0 if y < y0 else (y1 if y > y1 else y))
+        n = math.hypot(dx, dy)
+        if n > 1e-12:
+            return (dx / n, dy / n, 0.0)
+        # Centre over the box outline: push out along the nearest side.
+        sides = (
+            (x - x0, (-1.0, 0.0)),
+            (x1 - x, (1.0, 0.0)),
+            (y - y0, (0.0, -1.0)),
+            (y1 - y, (0.0, 1.0)),
+        )
+        nx, ny = min(sides)[1]
+        return (nx, ny, 0.0)
 
     def box_distance(self, box: BoxT, x: float, y: float, z: float) -> float:
         """Euclidean distance from a point to a box (0 inside)."""

@@ -44,6 +44,10 @@ from sitl.rotation import quat_from_euler, quat_to_euler
 from sitl.world import World
 
 G = GRAVITY_MPS2
+# A contact counts as a collision when it begins at this speed or more; pressing on an obstacle
+# re-touches it at millimetres per second and is not counted again.
+IMPACT_SPEED_MPS = 0.1
+IMPACT2 = IMPACT_SPEED_MPS**2
 
 
 class Core:
@@ -54,6 +58,7 @@ class Core:
         "ay",
         "az",
         "collided_with",
+        "collisions",
         "current_a",
         "m0",
         "m1",
@@ -89,6 +94,7 @@ class Core:
         self.voltage_v = 0.0
         self.on_ground = False
         self.collided_with: str | None = None
+        self.collisions = 0  # contacts begun at >= IMPACT_SPEED_MPS
 
 
 def advance(
@@ -158,12 +164,17 @@ def advance(
         c.vx, c.vy, c.vz = nvx, nvy, 0.0
         c.p = c.q = c.r = 0.0
         c.collided_with = None
-        hit = geom.cylinder_hit(c.x, c.y, c.z, prm.body_radius_m, prm.body_half_height_m)
-        if hit is not None:
-            c.x -= nvx * dt
-            c.y -= nvy * dt
-            c.vx = c.vy = 0.0
-            c.collided_with = hit
+        if nvx != 0.0 or nvy != 0.0:
+            hit = geom.cylinder_hit(c.x, c.y, c.z, prm.body_radius_m, prm.body_half_height_m)
+            if hit is not None:
+                c.x -= nvx * dt
+                c.y -= nvy * dt
+                c.vx = c.vy = 0.0
+                c.collided_with = hit
+                if speed_h >= IMPACT_SPEED_MPS:
+                    c.collisions += 1
+            # Slid off the edge of a box top: fall from the next step on.
+            c.on_ground = c.z >= geom.support_z(c.x, c.y, c.z) - prm.gear_height_m - 1e-9
         return
 
     # Torques in FRD (see module docstring for the signs).
@@ -203,10 +214,21 @@ def advance(
     if hit is not None and (
         geom.cylinder_hit(ox, oy, oz, prm.body_radius_m, prm.body_half_height_m) is None
     ):
-        # Stop where it was rather than tunnel into the obstacle.
+        # Stop at the last clear position (no tunnelling) and drop the velocity into the
+        # obstacle; motion along its surface goes on, so a vehicle never hangs on a wall.
         nx_, ny_, nz_ = ox, oy, oz
-        nvx = nvy = nvz = 0.0
+        cx, cy, cz = geom.contact_normal(hit, (ox, oy, oz), (nx_, ny_, nz_), prm.body_half_height_m)
+        into = nvx * cx + nvy * cy + nvz * cz
+        if into < 0.0:
+            nvx -= into * cx
+            nvy -= into * cy
+            nvz -= into * cz
+            sx, sy, sz = ox + nvx * dt, oy + nvy * dt, oz + nvz * dt
+            if geom.cylinder_hit(sx, sy, sz, prm.body_radius_m, prm.body_half_height_m) is None:
+                nx_, ny_, nz_ = sx, sy, sz
         on_ground = c.on_ground
+    if hit is not None and c.collided_with is None and vx * vx + vy * vy + vz * vz >= IMPACT2:
+        c.collisions += 1
     c.collided_with = hit
     c.ax, c.ay, c.az = (nvx - vx) / dt, (nvy - vy) / dt, (nvz - vz) / dt
     c.vx, c.vy, c.vz = nvx, nvy, nvz
@@ -246,6 +268,7 @@ class PhysicsState:
     voltage_v: float = 0.0
     on_ground: bool = False
     collided_with: str | None = None
+    collisions: int = 0
 
     @staticmethod
     def at_rest(
@@ -292,6 +315,7 @@ def to_state(c: Core) -> PhysicsState:
         voltage_v=c.voltage_v,
         on_ground=c.on_ground,
         collided_with=c.collided_with,
+        collisions=c.collisions,
     )
 
 
@@ -305,7 +329,7 @@ def from_state(s: PhysicsState) -> Core:
     c.p, c.q, c.r = (float(v) for v in s.omega_b)
     c.m0, c.m1, c.m2, c.m3 = (float(v) for v in s.motor_speed_radps)
     c.used_mah, c.current_a, c.voltage_v = s.used_mah, s.current_a, s.voltage_v
-    c.on_ground, c.collided_with = s.on_ground, s.collided_with
+    c.on_ground, c.collided_with, c.collisions = s.on_ground, s.collided_with, s.collisions
     return c
 
 

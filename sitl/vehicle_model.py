@@ -50,7 +50,8 @@ class TruthState:
     yaw_rad: float
     on_ground: bool
     motor_speed_radps: tuple[float, float, float, float]  # front, right, back, left
-    collided_with: str | None
+    collided_with: str | None  # obstacle touched in the last step, None when clear
+    collisions: int  # contacts begun at >= 0.1 m/s since the start
 
     @property
     def alt_m(self) -> float:
@@ -188,6 +189,7 @@ class SimVehicle:
             on_ground=c.on_ground,
             motor_speed_radps=(c.m0, c.m1, c.m2, c.m3),
             collided_with=c.collided_with,
+            collisions=c.collisions,
         )
 
     @property

@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sitl import physics
 from sitl.battery import battery_state, cell_ocv_v, terminal_voltage_v
@@ -228,6 +230,7 @@ def test_flying_into_a_wall_stops_there_and_names_it() -> None:
         hit = hit or t.collided_with
     assert hit == "wall_north"
     assert v.truth.vel_n[0] <= 1e-9
+    assert v.truth.collisions == 1  # pressing on the wall afterwards is the same collision
 
 
 def test_flying_into_a_box_names_it() -> None:
@@ -309,3 +312,32 @@ def test_params_validate_and_load_from_toml() -> None:
     with pytest.raises(ParamError, match="mass_kg: expected a number"):
         VehicleParams.from_toml({"mass_kg": "heavy"})
     assert VehicleParams.from_toml({"mass_kg": 1.8}).mass_kg == 1.8
+
+
+def test_sliding_off_a_box_edge_falls_to_the_floor() -> None:
+    p = VehicleParams()
+    world = World(boxes=(Box("crate", (-0.5, -0.5, -0.4), (0.5, 0.5, 0.0)),))
+    s = physics.PhysicsState.at_rest(p, world, (0.4, 0.0, -0.4))
+    assert s.on_ground and s.pos_n[2] == pytest.approx(-0.4 - p.gear_height_m)
+    s = dataclasses.replace(s, vel_n=np.array([1.5, 0.0, 0.0]))
+    for _ in range(400):
+        s = physics.step(s, [0.0] * 4, p, DT, world)
+    assert s.on_ground and s.pos_n[2] == pytest.approx(-p.gear_height_m)
+    assert s.pos_n[0] > 0.5
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    cmd=st.lists(st.floats(-0.5, 1.5) | st.just(math.nan), min_size=4, max_size=4),
+    seconds=st.floats(0.05, 1.5),
+)
+def test_any_throttles_keep_the_state_sane(cmd: list[float], seconds: float) -> None:
+    p, world = VehicleParams(), default_world()
+    s = physics.PhysicsState.at_rest(p, world, (0.0, 0.0, -1.0))
+    s = physics.step(s, cmd, p, seconds, world)
+    assert np.all(np.isfinite(s.pos_n)) and np.all(np.isfinite(s.omega_b))
+    assert float(np.dot(s.q_nb, s.q_nb)) == pytest.approx(1.0, abs=1e-9)
+    assert s.pos_n[2] <= -p.gear_height_m + 1e-12  # never below the floor
+    lo, hi = np.array(world.room_min_n), np.array(world.room_max_n)
+    assert np.all(s.pos_n >= lo) and np.all(s.pos_n <= hi)
+    assert 0.0 < s.voltage_v <= 12.6
