@@ -36,9 +36,13 @@ def mavlink2_frame(rng: np.random.Generator, sysid: int, msgid: int, payload_len
 
 
 def synthetic_flight(
-    duration_s: float, rng: np.random.Generator, t0_s: float = 100.0
+    duration_s: float, rng: np.random.Generator, t0_s: float = 100.0, rx_per_tick: int = 2
 ) -> Iterator[tuple[str, float, Any]]:
-    """(topic, t_s, payload) in time order; payload bytes for the raw topics."""
+    """(topic, t_s, payload) in time order; payload bytes for the raw topics.
+
+    `rx_per_tick` received frames per 25 ms tick: 2 is a thin link, 7 is ArduCopter's ≈ 290 msg/s
+    with every stream at 10 Hz.
+    """
     alt = vel = 0.0
     bias = float(rng.uniform(-0.15, 0.15))
     n_ticks = round(duration_s / TICK_S)
@@ -70,9 +74,9 @@ def synthetic_flight(
             yield "/vehicle/vfr_hud", t, VfrHud(t, 1, alt, vel, 39.0, 28.6, 0.0)
         if k % 40 == 0:
             yield "/vehicle/heartbeat", t, Heartbeat(t, 1, 1, 2, True, SystemStatus.ACTIVE, 209)
-        yield "rx", t, mavlink2_frame(rng, 1, 30, 28)
-        yield "rx", t + 0.001, mavlink2_frame(rng, 1, 27, 29)
-        yield "tx", t + 0.002, mavlink2_frame(rng, 255, 70, 18)
+        for j in range(rx_per_tick):
+            yield "rx", t + 0.0005 * j, mavlink2_frame(rng, 1, (30, 27, 74, 24, 1)[j % 5], 28)
+        yield "tx", t + 0.0005 * rx_per_tick, mavlink2_frame(rng, 255, 70, 18)
     if math.isnan(alt):
         raise AssertionError("synthetic flight diverged")
 
