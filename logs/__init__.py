@@ -1,5 +1,6 @@
 """Flight recording to MCAP, reading, recovery, replay, export and plots."""
 
+from logs.encoding import from_jsonable, to_jsonable, vector
 from logs.errors import RecordingError
 from logs.foxglove import (
     FoxgloveMessage,
@@ -30,5 +31,8 @@ __all__ = [
     "foxglove_scene_from_boxes",
     "foxglove_transform",
     "foxglove_vehicle_transform",
+    "from_jsonable",
     "open_recording",
+    "to_jsonable",
+    "vector",
 ]

@@ -182,3 +182,45 @@ def vector(value: Any) -> tuple[float, ...]:
         keys = QUAT_KEYS if "w" in value else VEC3_KEYS
         return tuple(float(value[k]) if value[k] is not None else math.nan for k in keys)
     return tuple(float(v) for v in value)
+
+
+def _from_hint(hint: Any, value: Any) -> Any:
+    if value is None:
+        return math.nan if hint is float else None
+    origin = typing.get_origin(hint)
+    if isinstance(hint, type) and issubclass(hint, enum.Enum):
+        return hint(value)
+    if hint is float:
+        return float(value)
+    if hint is int or hint is bool or hint is str:
+        return value
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):
+        return from_jsonable(hint, value)
+    if origin is tuple:
+        if isinstance(value, Mapping):
+            return vector(value)
+        args = [a for a in typing.get_args(hint) if a is not Ellipsis]
+        item = args[0] if len(set(args)) == 1 else None
+        return tuple(_from_hint(item, v) if item is not None else v for v in value)
+    if origin in (typing.Union, types.UnionType):
+        non_none = [a for a in typing.get_args(hint) if a is not type(None)]
+        if len(non_none) == 1:
+            return _from_hint(non_none[0], value)
+    return value
+
+
+def from_jsonable(cls: type, data: Mapping[str, Any]) -> Any:
+    """Rebuild a dataclass record from its recorded dict (the inverse of `to_jsonable`).
+
+    Vectors come back as tuples, enums as members, nulls in float fields as NaN; fields the
+    recording lacks take the dataclass default (an error if there is none).
+    """
+    if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
+        raise TypeError(f"{cls!r} is not a dataclass")
+    hints = _hints(cls)
+    kwargs = {
+        f.name: _from_hint(hints.get(f.name), data[f.name])
+        for f in dataclasses.fields(cls)
+        if f.name in data
+    }
+    return cls(**kwargs)
