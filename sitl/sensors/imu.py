@@ -2,6 +2,10 @@
 
 At rest and level the accelerometer reads the specific force (0, 0, −g): it measures everything
 but gravity, and the floor's push is up (−z in FRD).
+
+Thesis eq. 5.1 writes Acceleration = (9.81 / LSB)·1000, which is not a conversion from counts.
+The MPU-6050 gives counts with a sensitivity of 32768 / full-scale LSB per g (16384 at ±2 g),
+so a = counts · g · full_scale_g / 32768; that is what `acc_b` holds.
 """
 
 from __future__ import annotations

@@ -5,7 +5,8 @@ Room surfaces are planes, so the nearest point of a plane inside a cone is found
 cone ray closest to the plane's normal hits it at D / cos(max(β − θ, 0)), with D the
 perpendicular distance, β the angle between cone axis and normal and θ the half-angle. Boxes are
 found by casting rays: the axis, a ring on the cone's edge and a ring at half its angle. The
-sensors sit at the centre of gravity.
+sensors sit at the centre of gravity and look straight along the body axes (§8.6 suggests tilting
+them 15–30° off the body surface; the planners here assume the axes, so the tilt is left out).
 """
 
 from __future__ import annotations
@@ -74,7 +75,11 @@ def cone_rays_b(axis_b: Vec3, half_angle_rad: float, per_ring: int) -> tuple[Vec
             phi = 2.0 * math.pi * k / per_ring
             cp, sp = math.cos(phi) * sa, math.sin(phi) * sa
             rays.append(
-                tuple(ca * axis_b[i] + cp * u[i] + sp * v[i] for i in range(3))  # type: ignore[misc]
+                (
+                    ca * axis_b[0] + cp * u[0] + sp * v[0],
+                    ca * axis_b[1] + cp * u[1] + sp * v[1],
+                    ca * axis_b[2] + cp * u[2] + sp * v[2],
+                )
             )
     return tuple(rays)
 
