@@ -152,7 +152,7 @@ class EpbhaParams:
     weight_b: float = 2.0  # B of Definition 2, on the plane's second axis
     sensor_range_m: float = 0.5  # §8.6
     sensor_cone_deg: float = 45.0  # §8.6, full cone angle
-    keep_off_m: float = 0.2  # Subfunction 2's offset: >= body radius 0.15 m plus 5 cm
+    keep_off_m: float = 0.25  # Subfunction 2's offset: the 0.15 m body plus 10 cm
     body_radius_m: float = 0.17  # edge clearance wanted: the 0.15 m body plus 2 cm
     max_visits: int = 4  # visits of one cell after which the planner reports a loop
 
@@ -211,6 +211,7 @@ class _Manoeuvre:
     stage: int = 0
     clear_steps: int = 0
     last_seen_m: float = 0.0  # the watched edge's distance when the cone last saw it
+    pass_along_m: float = 0.0  # distance still to go alongside before the obstacle is passed
     back_next: bool = True
     lid_z_m: float | None = None  # NED z of a cave's lid underside, when one was measured
 
@@ -395,7 +396,12 @@ class Epbha:
     # --- manoeuvres -------------------------------------------------------------------
 
     def _keep_off(self, reading: ProximityReading) -> Move | None:
-        """The move away from anything nearer than keep_off, if that way is free."""
+        """The move away from anything nearer than keep_off, when that evens the gap.
+
+        In a gap narrower than twice keep_off (the goal under a table), backing off one side
+        would only bring the other side near: the move is taken only when the far side stays
+        farther than the near side after it, so keep-off never oscillates.
+        """
         nearest: tuple[float, Move] | None = None
         for move in Move:
             seen = reading.along_n(move.vec())
@@ -406,7 +412,10 @@ class Epbha:
         if nearest is None:
             return None
         away = nearest[1].opposite
-        return away if self._free(reading, away) else None
+        far = reading.along_n(away.vec())
+        if far is None or far > nearest[0] + 2.0 * self.params.step_m + 1e-9:
+            return away
+        return None
 
     def _start_manoeuvre(
         self,
@@ -420,6 +429,9 @@ class Epbha:
         side = self.lateral_toward_goal(pos, heading, reading)
         over = self._over_move(reading)
         man = _Manoeuvre(kind, heading, side, over)
+        seen_ahead = reading.along_n(heading.vec())
+        # Passing alongside must at least reach the face that blocked the way.
+        man.pass_along_m = (seen_ahead or 0.0) + self.params.body_radius_m
         if kind is ObstacleClass.CAVE:
             seen_up = reading.along_n(over.vec())
             if over is Move.UP and seen_up is not None:
@@ -461,9 +473,13 @@ class Epbha:
                 beside = man.side.opposite
                 man.clear_steps = self._watch(man, reading, beside)
                 heading_improves = not self._aligned(pos, man.heading.axis)
-                if man.clear_steps <= self._margin_steps(man) and heading_improves and self._free(
-                    reading, man.heading
+                short_of_face = man.pass_along_m > 1e-9
+                if (
+                    (short_of_face or man.clear_steps <= self._margin_steps(man))
+                    and heading_improves
+                    and self._free(reading, man.heading)
                 ):
+                    man.pass_along_m -= self.params.step_m
                     return go(man.heading, Reason.PASS_ALONG)
             self._manoeuvre = None
             return None

@@ -142,6 +142,7 @@ class ClutterParams:
     boxes: tuple[int, int] = (4, 9)  # inclusive range of obstacle count
     footprint_m: tuple[float, float] = (0.3, 1.4)
     height_m: tuple[float, float] = (0.3, 2.0)
+    pillar_fraction: float = 0.3  # share of boxes reaching the ceiling
     endpoint_clearance_m: float = 0.4
     alt_m: tuple[float, float] = (0.6, 1.6)
 
@@ -160,7 +161,9 @@ def random_room(rng: np.random.Generator, params: ClutterParams | None = None) -
             sn, se = rng.uniform(*p.footprint_m, size=2)
             n0 = rng.uniform(lo[0] + 1.0, hi[0] - 1.0 - sn)
             e0 = rng.uniform(lo[1], hi[1] - se)
-            height = rng.uniform(*p.height_m)
+            # Some boxes are cabinets or pillars up to the ceiling: no passing over those.
+            room_h = hi[2] - lo[2]
+            height = room_h if rng.uniform() < p.pillar_fraction else rng.uniform(*p.height_m)
             boxes.append(_box(f"clutter_{i}", (n0, n0 + sn), (e0, e0 + se), (0.0, height)))
         world = World(p.room, tuple(boxes))
         start = (lo[0] + 0.5, _uniform(rng, lo[1] + 0.5, hi[1] - 0.5), -_uniform(rng, *p.alt_m))

@@ -103,8 +103,9 @@ def test_partition_is_passed_over() -> None:
 def test_lateral_view_of_the_same_wall_is_not_a_partition() -> None:
     # A wall 0.2 m ahead shows in a side cone no nearer than 0.2 / sin(22.5°) = 0.52 m.
     p = planner()
-    d = p.step(START, reading(front=0.2, right=0.49))
-    assert d.obstacle is ObstacleClass.SINGLE_SIDED
+    assert p.classify(reading(front=0.2, right=0.49), Move.NORTH) is ObstacleClass.SINGLE_SIDED
+    # A wall 0.3 m ahead cannot show in a side cone within range: that is a wing.
+    assert p.classify(reading(front=0.3, right=0.49), Move.NORTH) is ObstacleClass.PARTITION
 
 
 def test_cave_backs_off_diagonally_as_a_staircase() -> None:
