@@ -101,6 +101,18 @@ def test_imu_counts_and_two_g_saturation() -> None:
     assert all(isinstance(c, int) for c in s.acc_raw + s.gyro_raw)
 
 
+def test_imu_in_tilted_flight_reads_thrust_along_body_z_only() -> None:
+    # Thrust is the only non-gravity force (drag ~0 at first): f_b = (0, 0, -T/m) at any tilt.
+    v = vehicle(pos=(0.0, 0.0, -1.5), noise=False, hovering=True)
+    v.set_pose((0.0, 0.0, -1.5), quat_from_euler(0.15, -0.25, 0.4))
+    u = v.hover_throttle()
+    v.step([u] * 4, 0.01)
+    s = v.imu()
+    assert abs(s.acc_b[0]) < 0.02 and abs(s.acc_b[1]) < 0.02
+    assert s.acc_b[2] == pytest.approx(-GRAVITY_MPS2, abs=0.05)  # hover thrust ≈ weight
+    assert v.truth.vel_n[0] != 0.0  # ...while the vehicle accelerates sideways in NED
+
+
 # --- sonar --------------------------------------------------------------------------------
 
 
