@@ -39,6 +39,7 @@ from firmware_link.records import (
     StatusText,
     SystemStatus,
     TelemetryRecord,
+    Vec3,
     VfrHud,
 )
 
@@ -73,7 +74,8 @@ class RecordConverter:
 
     autopilot_compid: int = AUTOPILOT_COMPID
     sonar: SonarLimits = field(default_factory=SonarLimits)
-    _origin: dict[int, tuple[float, float, float]] = field(default_factory=dict)
+    _origin: dict[int, tuple[float, float]] = field(default_factory=dict)
+    _origin_alt: dict[int, float] = field(default_factory=dict)
 
     def convert(self, msg: Any, t_s: float) -> list[TelemetryRecord]:
         """Records carried by `msg` (a pymavlink message), stamped with receive time `t_s`."""
@@ -237,22 +239,25 @@ class RecordConverter:
             time_usec=int(msg.time_usec),
         )
 
-    def _local_ned(self, sysid: int, lat_deg: float, lon_deg: float, alt_m: float) -> tuple:
-        origin = self._origin.setdefault(sysid, (lat_deg, lon_deg, alt_m))
-        north = math.radians(lat_deg - origin[0]) * EARTH_RADIUS_M
-        east = (
-            math.radians(lon_deg - origin[1]) * EARTH_RADIUS_M * math.cos(math.radians(origin[0]))
-        )
-        return (north, east, -(alt_m - origin[2]))
+    def _local_ned(self, sysid: int, lat_deg: float, lon_deg: float, alt_m: float) -> Vec3:
+        # Horizontal and vertical origins are kept apart: SIMSTATE has no altitude, so the
+        # first SIM_STATE sets the vertical one even when a SIMSTATE set the horizontal one.
+        lat0, lon0 = self._origin.setdefault(sysid, (lat_deg, lon_deg))
+        north = math.radians(lat_deg - lat0) * EARTH_RADIUS_M
+        east = math.radians(lon_deg - lon0) * EARTH_RADIUS_M * math.cos(math.radians(lat0))
+        if math.isnan(alt_m):
+            return (north, east, math.nan)
+        alt0 = self._origin_alt.setdefault(sysid, alt_m)
+        return (north, east, -(alt_m - alt0))
 
     def _simstate(self, msg: Any, t_s: float) -> SimTruth:
         sysid = msg.get_srcSystem()
-        north, east, _ = self._local_ned(sysid, msg.lat * 1e-7, msg.lng * 1e-7, 0.0)
+        pos_n = self._local_ned(sysid, msg.lat * 1e-7, msg.lng * 1e-7, math.nan)
         nan = math.nan
         return SimTruth(
             t_s=t_s,
             sysid=sysid,
-            pos_n=(north, east, nan),
+            pos_n=pos_n,
             vel_n=(nan, nan, nan),
             roll_rad=float(msg.roll),
             pitch_rad=float(msg.pitch),

@@ -227,6 +227,7 @@ class BringUpStep:
     period_ms: float
     requested_hz: float
     measured_hz: float
+    rx_bytes_per_s: float = 0.0  # everything the link carried during the window
 
 
 @dataclass(frozen=True, slots=True)
@@ -250,7 +251,7 @@ class BringUpReport:
         for s in self.steps:
             lines.append(
                 f"  step {s.period_ms:5.1f} ms: ATTITUDE asked {s.requested_hz:5.1f} Hz, "
-                f"got {s.measured_hz:5.1f} Hz"
+                f"got {s.measured_hz:5.1f} Hz; link carried {s.rx_bytes_per_s:6.0f} B/s"
             )
         lines.extend("  " + line for line in self.plan.budget_lines())
         for name, hz in self.achieved_hz:

@@ -732,15 +732,18 @@ class VehicleLink:
             last = k == len(periods) - 1
             window = final_window_s if last else step_hold_s
             self._rate_probe = measured = {}
+            bytes_before, t_before = self._ep.tally.rx_bytes, self._clock()
             try:
                 self._hold(window)
             finally:
                 self._rate_probe = None
+            elapsed = max(self._clock() - t_before, 1e-9)
             steps.append(
                 BringUpStep(
                     period_ms=period,
                     requested_hz=rates.get("ATTITUDE", 0.0),
                     measured_hz=measured_rate_hz(measured.get("ATTITUDE", []), window),
+                    rx_bytes_per_s=(self._ep.tally.rx_bytes - bytes_before) / elapsed,
                 )
             )
         achieved = tuple(

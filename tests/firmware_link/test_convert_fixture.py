@@ -163,3 +163,13 @@ def test_sim_state_gives_position_and_velocity() -> None:
     assert truth.pos_n[0] == pytest.approx(1.0, abs=0.01)  # 9e-6 deg of latitude ≈ 1 m
     assert truth.pos_n[2] == pytest.approx(-2.0)  # 2 m higher is 2 m up: NED z negative
     assert truth.vel_n == (1.0, 2.0, 0.5)
+
+
+def test_simstate_then_sim_state_share_an_origin_without_a_false_altitude() -> None:
+    conv = RecordConverter()
+    simstate = _msg("simstate_encode", 0, 0, 0, 0, 0, -G, 0, 0, 0, 473_000_000, 85_000_000)
+    (first,) = conv.convert(simstate, 0.0)
+    assert first.pos_n[:2] == (0.0, 0.0) and math.isnan(first.pos_n[2])
+    base = [1, 0, 0, 0, 0, 0, 0, 0, 0, -G, 0, 0, 0, 47.3, 8.5, 408.0, 0, 0, 0, 0, 0]
+    (truth,) = conv.convert(_msg("sim_state_encode", *base, 473_000_000, 85_000_000), 0.1)
+    assert truth.pos_n == (0.0, 0.0, 0.0)  # ground level, not -408 m
