@@ -64,6 +64,7 @@ class GaussianProcess:
     prior_mean: float
     _chol: np.ndarray
     _alpha: np.ndarray
+    _chol_inv: np.ndarray
 
     @classmethod
     def fit(
@@ -83,14 +84,16 @@ class GaussianProcess:
         k = se_kernel(x, x, hyper) + np.diag(nv)
         chol = _cholesky(k)
         alpha = _chol_solve(chol, y - prior_mean)
-        return cls(hyper, x, y, nv, float(prior_mean), chol, alpha)
+        # One triangular solve per fit; every prediction is then a product, not a solve.
+        chol_inv = np.linalg.solve(chol, np.eye(chol.shape[0]))
+        return cls(hyper, x, y, nv, float(prior_mean), chol, alpha, chol_inv)
 
     def predict(self, xq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Posterior mean (eq. 10.15) and latent variance (eq. 10.16) at points xq (m, 2)."""
         xq = np.asarray(xq, dtype=float).reshape(-1, 2)
         k_qs = se_kernel(xq, self.x_train, self.hyper)
         mean = self.prior_mean + k_qs @ self._alpha
-        v = np.linalg.solve(self._chol, k_qs.T)
+        v = self._chol_inv @ k_qs.T
         var = self.hyper.signal_std**2 - np.sum(v * v, axis=0)
         return mean, np.maximum(var, 0.0)
 

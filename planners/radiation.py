@@ -92,10 +92,10 @@ class Status(Enum):
 class RadiationMapperParams:
     """Tunables of the mapper; thesis values where the thesis gives one (Section 10.5)."""
 
-    x_min_m: float = 0.0
-    x_max_m: float = 20.0
-    y_min_m: float = 0.0
-    y_max_m: float = 20.0
+    x_min_m: float = -10.0  # the thesis's 20 x 20 m floor, centred as in worlds/*.toml
+    x_max_m: float = 10.0
+    y_min_m: float = -10.0
+    y_max_m: float = 10.0
     field_of_view_deg: float = 180.0  # Section 10.5: 180° vision
     samples_per_fan: int = 5  # Section 10.3: N = 5
     k1_gain_m: float = 3.0  # eq. 10.12, fan distance at the starting intensity
@@ -104,6 +104,7 @@ class RadiationMapperParams:
     dwell_s: float = 1.0  # detector integration per sample
     prospect_spacing_m: float = 4.0
     hotspot_separation_m: float = 1.5
+    hotspot_contrast: float = 4.0  # a hotspot's peak is at least this times the background
     unexplained_z: float = 5.0  # Poisson z-score of a reading the known sources do not explain
     unexplained_ratio: float = 1.5  # ... and reading / expected above this
     explained_radius_m: float = 2.0  # readings this close to a known hotspot are not candidates
@@ -565,7 +566,10 @@ class RadiationMapper:
         return Hotspot((float(pts[k, 0]), float(pts[k, 1])), float(math.exp(mean[k])))
 
     def _add_hotspot(self, hot: Hotspot) -> bool:
-        """Register a hotspot unless one is already known there; True if it was new."""
+        """Register a hotspot unless it is weak or already known; True if it was new."""
+        if hot.peak_cps < self.params.hotspot_contrast * self._background_cps():
+            # A climb that stalls in the background on noise has not found a source.
+            return False
         here = np.array(hot.pos_n)
         for h in self._hotspots:
             if np.linalg.norm(np.array(h.pos_n) - here) < self.params.hotspot_separation_m:
@@ -588,11 +592,12 @@ class RadiationMapper:
         """The reading the known hotspots explain worst, if they clearly fail to explain it."""
         p = self.params
         model = self._source_model()
-        if model is None:
-            return None
         pos = np.array(self._pos)
         cps = np.array(self._cps)
-        expected = model.intensity(pos[:, 0], pos[:, 1])
+        if model is None:
+            expected = np.full(cps.shape, self._background_cps())
+        else:
+            expected = model.intensity(pos[:, 0], pos[:, 1])
         z = (cps - expected) / np.sqrt(np.maximum(expected, 1.0) / p.dwell_s)
         ok = (z > p.unexplained_z) & (cps > p.unexplained_ratio * expected)
         known = [np.array(h.pos_n) for h in self._hotspots]
@@ -692,7 +697,7 @@ def run_radiation(
     params: RadiationMapperParams | None,
     rng: np.random.Generator,
     max_samples: int = 400,
-    start_n: tuple[float, float] = (1.0, 1.0),
+    start_n: tuple[float, float] = (-9.0, -9.0),
 ) -> RadiationResult:
     """Fly the mapper kinematically (perfect position hold) over an analytic field."""
     p = params or RadiationMapperParams()

@@ -1,9 +1,10 @@
 """Analytic radiation field: inverse-square point sources with softening over a flat background.
 
 Sources lie on the floor (z = 0); the detector flies ``height_m`` above it, so each source is seen
-at the 3D distance ``d``. A source of strength ``S`` (counts/s at 1 m) adds ``S / (d**2 + eps**2)``
-(``eps`` = ``softening_m`` keeps the field finite if the detector touches a source). The detector
-counts Poisson events over a dwell time and reports counts per second, as the SITL detector does.
+at the 3D distance ``d``. A source of strength ``S`` (counts/s at 1 m) adds
+``S (1 + eps**2) / (d**2 + eps**2)``: ``eps`` = ``softening_m`` keeps the field finite at the
+source while the rate at 1 m stays ``S``, the same law the SITL detector uses. The detector counts
+Poisson events over a dwell time and reports counts per second.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ class RadiationField:
     sources: tuple[PointSource, ...]
     background_cps: float
     height_m: float = 1.0
-    softening_m: float = 0.25
+    softening_m: float = 0.1
 
     def __post_init__(self) -> None:
         """Reject fields that cannot be sampled."""
@@ -48,7 +49,7 @@ class RadiationField:
         sources: list[tuple[float, float, float]] | tuple[tuple[float, float, float], ...],
         background_cps: float,
         height_m: float = 1.0,
-        softening_m: float = 0.25,
+        softening_m: float = 0.1,
     ) -> RadiationField:
         """Build a field from ``(x_m, y_m, strength_cps_at_1m)`` tuples."""
         return cls(
@@ -68,10 +69,11 @@ class RadiationField:
         x = np.asarray(x_m, dtype=float)
         y = np.asarray(y_m, dtype=float)
         total = np.full(np.broadcast(x, y).shape, self.background_cps, dtype=float)
-        floor_sq = self.height_m**2 + self.softening_m**2
+        soft_sq = self.softening_m**2
+        floor_sq = self.height_m**2 + soft_sq
         for s in self.sources:
             d_sq = (x - s.x_m) ** 2 + (y - s.y_m) ** 2 + floor_sq
-            total = total + s.strength_cps_at_1m / d_sq
+            total = total + s.strength_cps_at_1m * (1.0 + soft_sq) / d_sq
         return total
 
     def intensity_at(self, pos_n: np.ndarray | tuple[float, float]) -> float:
