@@ -34,6 +34,8 @@ from sitl.sensors.radiation import RadiationModel
 from sitl.sensors.sonar import SonarModel, SonarSample
 from sitl.world import FloorMaterial, World
 
+OTHER_VEHICLE = "vehicle"  # proximity target name for another vehicle's body
+
 
 @dataclass(frozen=True, slots=True)
 class TruthState:
@@ -266,10 +268,18 @@ class SimVehicle:
         thrust_frac = thrust / (4.0 * self.params.max_thrust_per_motor_n)
         return self._baro.sample(self.t_s, self._baro_z0 - c.z, rest_z - c.z, thrust_frac)
 
-    def proximity(self) -> list[ProximitySample]:
-        """Six IR readings: front, right, back, left, up, down."""
+    def proximity(self, others_n: Sequence[Vec3] = ()) -> list[ProximitySample]:
+        """Six IR readings: front, right, back, left, up, down.
+
+        `others_n` are the positions of other vehicles in the same world (flocking): each is
+        seen as a box the size of this airframe's body, named "vehicle".
+        """
         c = self._core
-        return self._prox.sample(self._geom, (c.x, c.y, c.z), (c.qw, c.qx, c.qy, c.qz))
+        r, h = self.params.body_radius_m, self.params.body_half_height_m
+        extra = tuple(
+            (x - r, y - r, z - h, x + r, y + r, z + h, OTHER_VEHICLE) for x, y, z in others_n
+        )
+        return self._prox.sample(self._geom, (c.x, c.y, c.z), (c.qw, c.qx, c.qy, c.qz), extra)
 
     def radiation(self, dt_s: float) -> float | None:
         """Counts/s over a window of dt_s ending now; None when the world has no sources."""

@@ -13,11 +13,21 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from sitl.geometry import CEILING, FLOOR, WALL_EAST, WALL_NORTH, WALL_SOUTH, WALL_WEST, Geometry
+from sitl.geometry import (
+    CEILING,
+    FLOOR,
+    WALL_EAST,
+    WALL_NORTH,
+    WALL_SOUTH,
+    WALL_WEST,
+    BoxT,
+    Geometry,
+)
 from sitl.rotation import Quat, Vec3, rotate_b_to_n
 from sitl.sensor_params import ProximityParams
 
@@ -110,13 +120,20 @@ class ProximityModel:
             ((0.0, 0.0, -1.0), oz - geom.rz0, CEILING),
         )
 
-    def sample(self, geom: Geometry, pos_n: Vec3, q_nb: Quat) -> list[ProximitySample]:
-        """The six readings (front, right, back, left, up, down) at pose (pos_n, q_nb)."""
+    def sample(
+        self, geom: Geometry, pos_n: Vec3, q_nb: Quat, extra_boxes: Sequence[BoxT] = ()
+    ) -> list[ProximitySample]:
+        """The six readings (front, right, back, left, up, down) at pose (pos_n, q_nb).
+
+        `extra_boxes` are further solids for this reading only (e.g. other vehicles' bodies).
+        """
         prm = self.params
         max_m = prm.max_m
         ox, oy, oz = pos_n
         planes = [pl for pl in self._planes(geom, pos_n) if pl[1] <= max_m]
-        boxes = [b for b in geom.boxes if geom.box_distance(b, ox, oy, oz) <= max_m]
+        boxes = [
+            b for b in (*geom.boxes, *extra_boxes) if geom.box_distance(b, ox, oy, oz) <= max_m
+        ]
         out: list[ProximitySample] = []
         cos_theta = math.cos(self.half_angle_rad)
         for facing, axis_b in FACING_AXIS_B.items():

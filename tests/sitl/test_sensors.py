@@ -285,6 +285,16 @@ def test_proximity_ignores_a_post_outside_every_cone() -> None:
     assert all(d is None for d in _by_facing(v).values())
 
 
+def test_proximity_sees_another_vehicle() -> None:
+    v = vehicle(pos=(0.0, 0.0, -1.5), noise=False, hovering=True)
+    samples = {s.facing: s for s in v.proximity(others_n=[(0.0, 0.6, -1.5)])}
+    right = samples[ProximityFacing.RIGHT]
+    assert right.target == "vehicle"
+    assert right.distance_m == pytest.approx(0.6 - VehicleParams().body_radius_m)
+    assert samples[ProximityFacing.LEFT].distance_m is None
+    assert all(s.distance_m is None for s in v.proximity(others_n=[(0.0, 1.5, -1.5)]))
+
+
 def test_proximity_noise() -> None:
     v = vehicle(pos=(2.7, 0.0, -1.5), hovering=True)
     values = [_by_facing(v)[ProximityFacing.FRONT] for _ in range(400)]
