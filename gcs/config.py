@@ -58,15 +58,24 @@ class StationConfig:
 
     period_s: float = 0.025
     estimator_kind: EstimatorKind = EstimatorKind.KALMAN
-    estimator: EstimatorParams = field(default_factory=EstimatorParams)
+    # sonar 5 cm below the centre of gravity, which stands 6 cm above the floor on its skids
+    estimator: EstimatorParams = field(
+        default_factory=lambda: EstimatorParams(sonar_offset_m=0.05, rest_alt_m=0.06)
+    )
     altitude: AltitudeControllerParams = field(default_factory=AltitudeControllerParams)
     position: PositionControllerParams = field(default_factory=PositionControllerParams)
     flight: FlightProfile = field(default_factory=FlightProfile)
     events_kept: int = 200
+    realtime_priority: int = 10  # SCHED_FIFO priority of the loop thread where allowed; 0: off
+    gil_switch_interval_s: float = 0.0005  # so other threads give the loop the GIL quickly
 
     def __post_init__(self) -> None:
         if not 0.001 <= self.period_s <= 1.0:
             raise ValueError(f"period_s must be in [0.001, 1], got {self.period_s}")
+        if not 0 <= self.realtime_priority <= 99:
+            raise ValueError(f"realtime_priority must be in 0..99, got {self.realtime_priority}")
+        if not 0.0 < self.gil_switch_interval_s <= 0.1:
+            raise ValueError("gil_switch_interval_s must be in (0, 0.1]")
 
 
 def _build(base: Any, data: dict[str, Any], where: str) -> Any:

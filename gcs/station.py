@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import enum
 import queue
+import sys
 import threading
 import time
 from collections import deque
@@ -187,7 +188,8 @@ class Station:
         self.estimator = make_estimator(self.config.estimator_kind.value, self.config.estimator)
         self.alt_ctrl = AltitudeController(self.config.altitude, self.curve, hover_throttle)
         self.pos_ctrl = PositionController(self.config.position)
-        self.loop = FixedRateLoop(self.clock, self.config.period_s, self._tick)
+        self.loop = FixedRateLoop(self.clock, self.config.period_s, self._tick,
+                                  realtime_priority=self.config.realtime_priority)
         self._intents: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
         self._lock = threading.Lock()
         self._events: deque[StationEvent] = deque(maxlen=self.config.events_kept)
@@ -206,6 +208,8 @@ class Station:
         if self._thread is not None:
             raise RuntimeError("station already started")
         self._running = True
+        # the loop needs the GIL within a fraction of a millisecond of waking (process-wide)
+        sys.setswitchinterval(min(sys.getswitchinterval(), self.config.gil_switch_interval_s))
         self._thread = threading.Thread(target=self._run, name="station-loop", daemon=True)
         self._thread.start()
 
@@ -238,6 +242,12 @@ class Station:
 
     def _run(self) -> None:
         try:
+            if self.config.realtime_priority > 0:
+                self.loop.run(max_ticks=0)  # takes real-time priority on this thread
+                self._event(self.clock.now_s(), EventLevel.INFO if self.loop.realtime
+                            else EventLevel.WARNING,
+                            "loop thread runs at real-time priority" if self.loop.realtime
+                            else "real-time priority not permitted: loop timing may jitter")
             self.loop.run()
         except BaseException as exc:
             self._error = exc

@@ -31,6 +31,8 @@ class EstimatorParams:
     duplicate_window_s: float = 0.2  # an identical distance within this time is a repeat
     stale_after_s: float = 0.25  # no accepted sonar for longer: coasting on the accelerometer
     ground_alt_m: float = 0.10  # below this estimate a zero sonar reading means "on the floor"
+    sonar_offset_m: float = 0.0  # sonar mounted this far below the centre of gravity (body z)
+    rest_alt_m: float = 0.0  # centre-of-gravity height when standing on the floor
     complementary_tc_s: float = 1.0  # T of the third-order filter (gains 3/T, 3/T², 1/T³)
     max_dt_s: float = 0.2  # longer gaps (a stalled link) are integrated as this at most
 
@@ -162,15 +164,15 @@ class AltEstimator(ABC):
         if not in_range:
             if d <= p.sonar_min_m and alt_pred < p.ground_alt_m:
                 # the HC-SR04 reads 0 below its minimum: on the floor, that *is* the altitude
-                self._correct(0.0, t_s)
+                self._correct(p.rest_alt_m, t_s)
                 self._initialised = True
                 self._last_sonar_t_s = t_s
-                return SonarStatus.GROUND, -alt_pred
+                return SonarStatus.GROUND, p.rest_alt_m - alt_pred
             return SonarStatus.INVALID, 0.0
         if d == self._last_distance and t_s - self._last_distance_t_s < p.duplicate_window_s:
             return SonarStatus.DUPLICATE, 0.0
         self._last_distance, self._last_distance_t_s = d, t_s
-        z = sonar_altitude_m(d, self._roll, self._pitch)
+        z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
         innovation = z - alt_pred
         if not self._initialised:
             # the first in-range reading sets the altitude; nothing to gate it against yet

@@ -28,6 +28,10 @@ from gcs.station import ControlMode, EventLevel, Station
 from gcs.thrust_curve import ThrottleCurve
 
 
+REST_M = 0.06  # the station's default vehicle geometry
+SONAR_BELOW_CG_M = 0.05
+
+
 class FakeBoard:
     """A point-mass quadrotor behind an APM-2.5-like link (the one thing tests may mock)."""
 
@@ -35,7 +39,7 @@ class FakeBoard:
         self.clock = clock
         self.curve = ThrottleCurve.for_dialect(Dialect.APM25)
         self.hover_true = hover_true
-        self.h = 0.0
+        self.h = REST_M  # centre of gravity above the floor
         self.v = 0.0
         self.t = clock.now_s()
         self.cmd = RcCommand()
@@ -57,9 +61,9 @@ class FakeBoard:
         a = GRAVITY_MPS2 * motor / self.hover_true - GRAVITY_MPS2
         self.v += a * dt
         self.h += self.v * dt
-        if self.h <= 0.0:
-            self.h, self.v = 0.0, max(self.v, 0.0)
-        self._a = a if self.h > 0 else 0.0
+        if self.h <= REST_M:
+            self.h, self.v = REST_M, max(self.v, 0.0)
+        self._a = a if self.h > REST_M else 0.0
 
     def poll(self) -> list[Any]:
         if self.fail_poll:
@@ -76,7 +80,7 @@ class FakeBoard:
             SimTruth(now, 1, (0.0, 0.0, -self.h), (0.0, 0.0, -self.v), 0.0, 0.0, 0.0, "SIMSTATE"),
         ]
         if self._k % 2 == 0:
-            d = self.h + 0.001 * math.sin(self._k)  # keeps readings distinct
+            d = self.h - SONAR_BELOW_CG_M + 0.001 * math.sin(self._k)  # readings stay distinct
             out.append(Rangefinder(now, 1, d if d >= 0.02 else 0.0, d >= 0.02, "RANGEFINDER"))
         if self._k % 40 == 1:
             out.append(Heartbeat(now, 1, 1, 0, self.armed, SystemStatus.STANDBY, 81))

@@ -1,0 +1,218 @@
+"""`quadgcs fly`: take off, hold an altitude under the PC's 25 ms loop, land, print a summary.
+
+With no `--connect` it starts the bundled SITL and flies that. `--json` prints one JSON object;
+`--live` prints a telemetry line a few times per second while flying.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from firmware_link import LinkError, LinkUsageError, MocapLink, VehicleLink, load_signing_key
+from firmware_link.records import Dialect
+from gcs.clock import Clock, MonotonicClock, ScaledClock
+from gcs.config import load_config
+from gcs.errors import RuntimeFault, UsageError
+from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
+from gcs.sitl_process import SitlOptions, SitlProcess
+from gcs.station import Station, StationSnapshot
+from gcs.thrust_curve import ThrottleCurve
+
+CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the `fly` subcommand."""
+    p = sub.add_parser("fly", help="hold an altitude under the PC controller, then land",
+                       description=__doc__)
+    p.add_argument("--connect", metavar="URL",
+                   help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
+                        "default: start the bundled SITL")
+    p.add_argument("--mocap", metavar="URL", help="motion-capture endpoint (tcp:HOST:PORT)")
+    p.add_argument("--alt", type=float, default=1.0, help="hold altitude, m (default 1.0)")
+    p.add_argument("--hold", type=float, default=30.0, help="hold time, s (default 30)")
+    p.add_argument("--step", type=float, default=0.0,
+                   help="after the hold, step the setpoint by this many m and score it")
+    p.add_argument("--profile", choices=("apm25", "copter4"), default="apm25",
+                   help="firmware profile of the bundled SITL (default apm25)")
+    p.add_argument("--world", type=Path, help="world TOML for the bundled SITL")
+    p.add_argument("--serial", action="store_true",
+                   help="fly the bundled SITL over its pseudo-terminal serial port (115200 baud)")
+    p.add_argument("--speedup", type=float, default=1.0,
+                   help="run the bundled SITL and the loop this many times faster (default 1)")
+    p.add_argument("--seed", type=int, help="seed of the bundled SITL's noise")
+    p.add_argument("--config", type=Path, help="station TOML (gains, estimator, timing)")
+    p.add_argument("--signing-key", type=Path, help="MAVLink 2 signing key file (ArduCopter 4.x)")
+    p.add_argument("--record", action=argparse.BooleanOptionalAction, default=True,
+                   help="record the flight to MCAP (default on)")
+    p.add_argument("-o", "--output", type=Path, default=Path("flights"),
+                   help="recording file or directory (default flights/)")
+    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    p.add_argument("--live", action="store_true", help="print telemetry lines while flying")
+    p.set_defaults(func=run)
+
+
+def _plan(args: argparse.Namespace) -> FlightPlan:
+    try:
+        return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step)
+    except ValueError as exc:
+        raise UsageError(f"--alt/--hold/--step: {exc}") from None
+
+
+def _open_recorder(args: argparse.Namespace, meta: dict[str, str]) -> Any:
+    if not args.record:
+        return None
+    from logs import Recorder, RecordingError
+
+    try:
+        return Recorder(args.output, metadata=meta)
+    except RecordingError as exc:
+        raise UsageError(f"-o {args.output}: {exc}") from None
+
+
+class LivePrinter:
+    """Prints a telemetry line at most every `period_s` of the station clock."""
+
+    def __init__(self, clock: Clock, period_s: float = 0.25) -> None:
+        self.clock = clock
+        self.period_s = period_s
+        self._next = -math.inf
+
+    def __call__(self, snap: StationSnapshot, phase: Phase) -> None:
+        now = self.clock.now_s()
+        if now < self._next:
+            return
+        self._next = now + self.period_s
+        est = snap.estimate
+        truth = f"{-snap.truth.pos_n[2]:6.3f}" if snap.truth else "   n/a"
+        att = snap.attitude
+        print(
+            f"{phase.value:8s} alt {est.alt_m if est else math.nan:6.3f} m "
+            f"(truth {truth}) set {snap.alt_setpoint_m or 0.0:5.2f} m "
+            f"vz {est.vel_mps if est else math.nan:+5.2f} m/s "
+            f"thr {snap.command.throttle_us} us "
+            f"roll {math.degrees(att.roll_rad) if att else 0.0:+5.1f} "
+            f"pitch {math.degrees(att.pitch_rad) if att else 0.0:+5.1f} deg "
+            f"{'ARMED' if snap.armed else 'disarmed'}{' LINK LOST' if snap.link_lost else ''}",
+            flush=True,
+        )
+
+
+def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> dict[str, Any]:
+    d: dict[str, Any] = {
+        "rms_error_m": round(s.rms_error_m, 4),
+        "max_error_m": round(s.max_error_m, 4),
+        "error_source": s.error_source,
+        "jitter_p50_ms": round(s.jitter_p50_ms, 3),
+        "jitter_p99_ms": round(s.jitter_p99_ms, 3),
+        "compute_p99_ms": round(s.compute_p99_ms, 3),
+        "overruns": s.overruns,
+        "ticks": s.ticks,
+        "rx_messages": s.rx_messages,
+        "lost_messages": s.lost_messages,
+        "corrupted_frames": s.corrupted,
+        "hover_throttle": round(s.hover_throttle, 4),
+        "dialect": dialect.value,
+        "recording": recording,
+    }
+    if s.step is not None:
+        d["step"] = {
+            "step_m": s.step.step_m,
+            "overshoot_pct": round(s.step.overshoot_pct, 2),
+            "settle_time_s": s.step.settle_time_s if math.isfinite(s.step.settle_time_s)
+            else None,
+            "band_m": s.step.band_m,
+        }
+    return d
+
+
+def _print_summary(d: dict[str, Any]) -> None:
+    print(f"altitude hold ({d['error_source']}): RMS error {d['rms_error_m'] * 100:.1f} cm, "
+          f"worst {d['max_error_m'] * 100:.1f} cm")
+    if "step" in d:
+        st = d["step"]
+        settle = "never" if st["settle_time_s"] is None else f"{st['settle_time_s']:.2f} s"
+        print(f"step {st['step_m']:+.2f} m: overshoot {st['overshoot_pct']:.1f} %, "
+              f"settled within ±{st['band_m'] * 100:.0f} cm after {settle}")
+    print(f"loop: jitter p50 {d['jitter_p50_ms']:.3f} ms, p99 {d['jitter_p99_ms']:.3f} ms, "
+          f"compute p99 {d['compute_p99_ms']:.3f} ms, overruns {d['overruns']} "
+          f"of {d['ticks']} ticks")
+    print(f"link ({d['dialect']}): {d['rx_messages']} messages received, "
+          f"{d['lost_messages']} lost, {d['corrupted_frames']} corrupted")
+    print(f"learned hover throttle {d['hover_throttle']:.3f}")
+    print(f"recording: {d['recording'] or 'off'}")
+
+
+def fly(args: argparse.Namespace) -> dict[str, Any]:
+    """Run the whole flight; return the summary dict (the CLI prints it)."""
+    config = load_config(args.config)
+    plan = _plan(args)
+    if args.speedup <= 0 or args.speedup > 50:
+        raise UsageError(f"--speedup {args.speedup}: expected 0 < speedup <= 50")
+    key = None
+    if args.signing_key is not None:
+        try:
+            key = load_signing_key(args.signing_key)
+        except (LinkUsageError, OSError, ValueError) as exc:
+            raise UsageError(f"--signing-key {args.signing_key}: {exc}") from None
+    if args.world is not None and not args.world.is_file():
+        raise UsageError(f"--world {args.world}: no such file")
+    clock: Clock = MonotonicClock() if args.speedup == 1.0 else ScaledClock(args.speedup)
+    with contextlib.ExitStack() as stack:
+        url, mocap_url = args.connect, args.mocap
+        if url is None:
+            sitl = SitlProcess(SitlOptions(profile=args.profile, world=args.world,
+                                           speedup=args.speedup, serial=args.serial,
+                                           seed=args.seed, signing_key=args.signing_key))
+            endpoints = sitl.start()
+            stack.callback(sitl.stop)
+            url = endpoints.url(1, serial=args.serial)
+            mocap_url = mocap_url or endpoints.mocap
+        recorder = _open_recorder(args, {"command": "fly", "url": url})
+        if recorder is not None:
+            stack.callback(recorder.close)
+        link = VehicleLink.open(url, signing_key=key, clock=clock.now_s,
+                                on_raw=recorder.put_raw if recorder is not None else None)
+        stack.callback(link.close)
+        link.bring_up(40.0)
+        params: dict[str, float] = {}
+        for name in CURVE_PARAMS.get(link.dialect, ()):
+            with contextlib.suppress(LinkError):
+                params[name] = link.get_param(name)
+        curve = ThrottleCurve.for_dialect(link.dialect, params)
+        mocap = None
+        if mocap_url is not None:
+            mocap = MocapLink.open(mocap_url, clock=clock.now_s)
+            stack.callback(mocap.close)
+        station = Station(link, config=config, curve=curve, mocap=mocap, recorder=recorder,
+                          clock=clock)
+        station.start()
+        stack.callback(station.stop)
+        runner = FlightRunner(station, plan, LivePrinter(clock) if args.live else None)
+        try:
+            runner.fly()
+        except BaseException:
+            # leave the vehicle to its own failsafe with the throttle at minimum, not mid-air
+            station.kill()
+            raise
+        summary = runner.summary()
+        path = str(recorder.path) if recorder is not None else None
+        return _summary_dict(summary, path, link.dialect)
+    raise RuntimeFault("flight ended without a summary")
+
+
+def run(args: argparse.Namespace) -> int:
+    """CLI entry: fly, then print the summary (text or JSON)."""
+    d = fly(args)
+    if args.json:
+        json.dump(d, sys.stdout)
+        print()
+    else:
+        _print_summary(d)
+    return 0

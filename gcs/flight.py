@@ -1,0 +1,296 @@
+"""A scripted flight under the PC controller: arm, take off, hold, optional step, land, disarm.
+
+This is the thesis's Chapter 7 experiment as a procedure: it drives a running `Station` through
+intents, records one sample per tick through a station listener, and scores the hold (RMS and
+worst altitude error, against the SITL's ground truth when the vehicle sends it, else against
+the station's own estimate) and the step (overshoot, settling time).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from firmware_link.records import FlightMode
+from gcs.errors import RuntimeFault
+from gcs.station import ControlMode, Station, StationSnapshot
+
+
+class Phase(enum.Enum):
+    """Where the flight is."""
+
+    GROUND = "ground"
+    TAKEOFF = "takeoff"
+    SETTLE = "settle"
+    HOLD = "hold"
+    STEP = "step"
+    LAND = "land"
+    DONE = "done"
+
+
+@dataclass(frozen=True, slots=True)
+class FlightSample:
+    """One tick of the flight: times in the station clock's seconds, altitudes up."""
+
+    t_s: float
+    phase: Phase
+    setpoint_m: float | None
+    target_m: float | None
+    est_alt_m: float | None
+    truth_alt_m: float | None
+    throttle_us: int
+
+
+@dataclass(frozen=True, slots=True)
+class StepMetrics:
+    """Response to a setpoint step."""
+
+    step_m: float
+    overshoot_pct: float
+    settle_time_s: float  # last time outside ±band, from the step (inf if never settled)
+    band_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class FlightPlan:
+    """What to fly."""
+
+    alt_m: float = 1.0
+    hold_s: float = 30.0
+    settle_s: float = 4.0
+    step_m: float = 0.0  # 0: no step
+    step_observe_s: float = 8.0
+    step_band_m: float = 0.05
+    climb_mps: float = 0.5
+    descent_mps: float = 0.3
+    handover_alt_m: float = 0.15
+    arm_timeout_s: float = 40.0
+
+    def __post_init__(self) -> None:
+        if not 0.2 <= self.alt_m <= 3.5:
+            raise ValueError(f"altitude {self.alt_m} m outside 0.2..3.5 m (the sonar's range)")
+        if self.hold_s <= 0.0:
+            raise ValueError(f"hold time must be > 0 s, got {self.hold_s}")
+        if not 0.2 <= self.alt_m + self.step_m <= 3.5:
+            raise ValueError(f"step to {self.alt_m + self.step_m} m leaves 0.2..3.5 m")
+
+
+@dataclass(frozen=True, slots=True)
+class FlightSummary:
+    """The flight's score card."""
+
+    rms_error_m: float
+    max_error_m: float
+    error_source: str  # "truth" or "estimate"
+    step: StepMetrics | None
+    jitter_p50_ms: float
+    jitter_p99_ms: float
+    compute_p99_ms: float
+    overruns: int
+    ticks: int
+    rx_messages: int
+    lost_messages: int
+    corrupted: int
+    hover_throttle: float
+    samples: tuple[FlightSample, ...] = field(repr=False)
+
+
+def _finite(x: float | None) -> bool:
+    return x is not None and math.isfinite(x)
+
+
+def _truth_alt(snap: StationSnapshot) -> float | None:
+    return -snap.truth.pos_n[2] if snap.truth is not None else None
+
+
+class FlightRunner:
+    """Runs a `FlightPlan` on a started station from the calling thread."""
+
+    def __init__(self, station: Station, plan: FlightPlan,
+                 on_progress: Callable[[StationSnapshot, Phase], None] | None = None,
+                 rest_alt_m: float | None = None) -> None:
+        self.station = station
+        # the truth's vertical origin is whatever the vehicle reported first; the flight starts
+        # on the floor, where the centre of gravity is known to stand at rest_alt_m
+        self.rest_alt_m = (station.config.estimator.rest_alt_m if rest_alt_m is None
+                           else rest_alt_m)
+        self.plan = plan
+        self.phase = Phase.GROUND
+        self.samples: list[FlightSample] = []
+        self._on_progress = on_progress
+        self._target: float | None = None
+        station.add_listener(self._sample)
+
+    def _sample(self, snap: StationSnapshot) -> None:
+        est = snap.estimate
+        self.samples.append(FlightSample(
+            t_s=snap.t_s,
+            phase=self.phase,
+            setpoint_m=snap.alt_setpoint_m,
+            target_m=self._target,
+            est_alt_m=est.alt_m if est is not None else None,
+            truth_alt_m=_truth_alt(snap),
+            throttle_us=snap.command.throttle_us,
+        ))
+
+    # -------------------------------------------------------------- waiting
+    def _wait(self, what: str, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> None:
+        """Wait `timeout_s` on the station's clock for `pred`; RuntimeFault naming `what`."""
+        clock = self.station.clock
+        deadline = clock.now_s() + timeout_s
+        while True:
+            snap = self.station.snapshot()
+            if self.station.error is not None:
+                raise RuntimeFault(f"control loop stopped: {self.station.error}")
+            if pred(snap):
+                return
+            if self._on_progress is not None:
+                self._on_progress(snap, self.phase)
+            if clock.now_s() >= deadline:
+                raise RuntimeFault(f"{what} did not happen within {timeout_s:g} s")
+            time.sleep(0.02)
+
+    def _sleep(self, seconds: float) -> None:
+        clock = self.station.clock
+        end = clock.now_s() + seconds
+        while clock.now_s() < end:
+            if self.station.error is not None:
+                raise RuntimeFault(f"control loop stopped: {self.station.error}")
+            if self._on_progress is not None:
+                self._on_progress(self.station.snapshot(), self.phase)
+            time.sleep(0.02)
+
+    # -------------------------------------------------------------- the flight
+    def arm(self) -> None:
+        """STABILIZE, throttle at minimum, arm (retried: pre-arm checks may still be running)."""
+        st = self.station
+        st.set_sticks(1500, 1500, 1500, 1000)
+        st.set_mode(FlightMode.STABILIZE)
+        self._wait("STABILIZE mode", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 10.0)
+        clock = st.clock
+        deadline = clock.now_s() + self.plan.arm_timeout_s
+        while True:
+            st.request_arm()
+            try:
+                self._wait("arming", lambda s: s.armed, 2.0)
+                return
+            except RuntimeFault:
+                if clock.now_s() >= deadline:
+                    reasons = [e.text for e in st.snapshot().events if "vehicle:" in e.text]
+                    why = f" ({reasons[-1]})" if reasons else ""
+                    raise RuntimeFault(f"vehicle did not arm within "
+                                       f"{self.plan.arm_timeout_s:g} s{why}") from None
+
+    def fly(self) -> None:
+        """Take off, settle, hold, step (if asked), land and disarm."""
+        p = self.plan
+        st = self.station
+        self.arm()
+        self.phase = Phase.TAKEOFF
+        self._target = p.alt_m
+        st.alt_hold(True, p.alt_m, rate_mps=p.climb_mps)
+        climb_s = p.alt_m / p.climb_mps
+        self._wait("take-off to the hold altitude",
+                   lambda s: s.estimate is not None and abs(s.estimate.alt_m - p.alt_m) < 0.1
+                   and s.alt_setpoint_m is not None and abs(s.alt_setpoint_m - p.alt_m) < 1e-6,
+                   climb_s + 15.0)
+        self.phase = Phase.SETTLE
+        self._sleep(p.settle_s)
+        self.phase = Phase.HOLD
+        self._sleep(p.hold_s)
+        if p.step_m:
+            self.phase = Phase.STEP
+            self._target = p.alt_m + p.step_m
+            st.alt_hold(True, p.alt_m + p.step_m)  # a true step: the controller's own profile
+            self._sleep(p.step_observe_s)
+        self.land()
+
+    def land(self) -> None:
+        """Descend under PC control, then throttle to minimum near the floor and disarm."""
+        p = self.plan
+        st = self.station
+        self.phase = Phase.LAND
+        self._target = 0.0
+        if st.snapshot().mode is not ControlMode.MANUAL:
+            st.alt_hold(True, 0.0, rate_mps=p.descent_mps)
+            start = st.snapshot().estimate
+            top = start.alt_m if start is not None else p.alt_m
+            self._wait("descent", lambda s: s.estimate is not None
+                       and s.estimate.alt_m < p.handover_alt_m, top / p.descent_mps + 15.0)
+        st.set_sticks(1500, 1500, 1500, 1000)
+        st.alt_hold(False)
+        self._sleep(1.0)
+        st.request_disarm()
+        try:
+            self._wait("disarm", lambda s: not s.armed, 5.0)
+        except RuntimeFault:
+            st.request_disarm()
+            self._wait("disarm", lambda s: not s.armed, 5.0)
+        self.phase = Phase.DONE
+
+    # -------------------------------------------------------------- scoring
+    def summary(self) -> FlightSummary:
+        """Score the flight from the samples and the station's statistics."""
+        snap = self.station.snapshot()
+        hold = [s for s in self.samples if s.phase is Phase.HOLD and s.setpoint_m is not None]
+        use_truth = (bool(hold) and self.truth_origin_m() is not None
+                     and all(_finite(s.truth_alt_m) for s in hold))
+        errs = np.array([self._alt(s, use_truth) - (s.setpoint_m or 0.0) for s in hold])
+        rms = float(np.sqrt(np.mean(errs**2))) if errs.size else math.nan
+        worst = float(np.max(np.abs(errs))) if errs.size else math.nan
+        step = self._step_metrics(use_truth)
+        ls = snap.loop
+        stats = snap.link_stats
+        return FlightSummary(
+            rms_error_m=rms,
+            max_error_m=worst,
+            error_source="truth" if use_truth else "estimate",
+            step=step,
+            jitter_p50_ms=ls.jitter_p50_s * 1e3,
+            jitter_p99_ms=ls.jitter_p99_s * 1e3,
+            compute_p99_ms=ls.compute_p99_s * 1e3,
+            overruns=ls.overruns,
+            ticks=ls.ticks,
+            rx_messages=int(getattr(stats, "rx_messages", 0)),
+            lost_messages=int(getattr(stats, "lost_messages", 0)),
+            corrupted=int(getattr(stats, "bad_frames", 0)),
+            hover_throttle=snap.hover_throttle,
+            samples=tuple(self.samples),
+        )
+
+    def truth_origin_m(self) -> float | None:
+        """Offset to subtract from reported truth altitudes (from the samples on the floor)."""
+        ground = [s.truth_alt_m for s in self.samples
+                  if s.phase is Phase.GROUND and _finite(s.truth_alt_m)]
+        if not ground:
+            return None
+        return float(np.median(np.array(ground, dtype=float))) - self.rest_alt_m
+
+    def _alt(self, s: FlightSample, use_truth: bool) -> float:
+        if use_truth:
+            origin = self.truth_origin_m()
+            assert origin is not None and s.truth_alt_m is not None
+            return s.truth_alt_m - origin
+        return s.est_alt_m if s.est_alt_m is not None else math.nan
+
+    def _step_metrics(self, use_truth: bool) -> StepMetrics | None:
+        p = self.plan
+        step = [s for s in self.samples if s.phase is Phase.STEP]
+        if not p.step_m or not step:
+            return None
+        t0 = step[0].t_s
+        target = p.alt_m + p.step_m
+        alts = np.array([self._alt(s, use_truth) for s in step])
+        ts = np.array([s.t_s - t0 for s in step])
+        beyond = (alts - target) * math.copysign(1.0, p.step_m)
+        overshoot = max(0.0, float(beyond.max())) / abs(p.step_m) * 100.0
+        outside = ts[np.abs(alts - target) > p.step_band_m]
+        settle = float(outside.max()) if outside.size else 0.0
+        if outside.size and outside.max() >= ts[-1] - 1e-9:
+            settle = math.inf
+        return StepMetrics(p.step_m, overshoot, settle, p.step_band_m)
