@@ -8,9 +8,9 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from logs.reader import Recording
-from logs.topics import EVENTS_TOPIC, LOG_TOPIC
+from logs.topics import EVENTS_TOPIC, LINK_EVENTS_TOPIC, LOG_TOPIC
 
-_LOST_TEXT = re.compile(r"^\s*LOST\b|\blink lost\b", re.IGNORECASE)
+_LOST_TEXT = re.compile(r"^\s*LOST\b|\blink (was )?lost\b", re.IGNORECASE)
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,12 +55,12 @@ class RecordingSummary:
 
 
 def _is_loss(topic: str, message: dict[str, Any]) -> str | None:
-    if topic == EVENTS_TOPIC and str(message.get("kind", "")).lower() == "lost":
+    """The text of a link-loss event, or None: a LinkEvent of kind "lost", or a log line."""
+    if str(message.get("kind", "")).lower() == "lost":
         return str(message.get("detail", "lost"))
-    if topic == LOG_TOPIC:
-        text = str(message.get("message", ""))
-        if _LOST_TEXT.search(text):
-            return text
+    text = message.get("message", message.get("text"))
+    if isinstance(text, str) and _LOST_TEXT.search(text):
+        return text
     return None
 
 
@@ -80,14 +80,21 @@ def summarize(recording: Recording) -> RecordingSummary:
             if d > gap.get(topic, (-1, 0))[0]:
                 gap[topic] = (d, prev)
         last[topic] = log_ns
-    losses: list[LinkLoss] = []
-    event_topics = [t for t in (EVENTS_TOPIC, LOG_TOPIC) if t in recording.counts]
-    json_event_topics = [t for t in event_topics if info[t].message_encoding == "json"]
-    if json_event_topics:
-        for topic, log_ns, message in recording.messages(json_event_topics):
+    # The link's own events are the best witness; the station's and the log lines repeat them,
+    # so the first of these topics that reports any loss is the one counted.
+    by_topic: dict[str, list[LinkLoss]] = {}
+    event_topics = [
+        t
+        for t in (LINK_EVENTS_TOPIC, EVENTS_TOPIC, LOG_TOPIC)
+        if t in recording.counts and info[t].message_encoding == "json"
+    ]
+    if event_topics:
+        for topic, log_ns, message in recording.messages(event_topics):
             text = _is_loss(topic, message)
             if text is not None:
-                losses.append(LinkLoss((log_ns - start_ns) / 1e9, topic, text))
+                loss = LinkLoss((log_ns - start_ns) / 1e9, topic, text)
+                by_topic.setdefault(topic, []).append(loss)
+    losses = next((by_topic[t] for t in event_topics if by_topic.get(t)), [])
     rows = []
     for topic, topic_info in info.items():
         n = topic_info.count
@@ -112,7 +119,7 @@ def summarize(recording: Recording) -> RecordingSummary:
         messages=sum(recording.counts.values()),
         vehicle=str(meta.get("vehicle", "")),
         software_version=str(meta.get("software_version", "")),
-        connection=str(meta.get("connection", "")),
+        connection=str(meta.get("connection", meta.get("url", ""))),
         truncated=recording.truncated,
         topics=tuple(rows),
         link_losses=tuple(losses),

@@ -8,7 +8,6 @@ accelerometer with the sonar. matplotlib is optional and imported only here, onl
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -53,9 +52,12 @@ def extract_series(recording: Recording) -> dict[str, Series]:
                 vs.append(value)
     out: dict[str, Series] = {}
     for s in SIGNALS:
-        ts, vs = samples[s.name]
-        if ts and not all(math.isnan(v) for v in vs):
-            out[s.name] = Series(s, np.asarray(ts), np.asarray(vs, dtype=float))
+        t_arr = np.asarray(samples[s.name][0])
+        v_arr = np.asarray(samples[s.name][1], dtype=float)
+        # missing samples (a message without this field, an invalid sonar) would break the line
+        keep = np.isfinite(v_arr)
+        if keep.any():
+            out[s.name] = Series(s, t_arr[keep], v_arr[keep])
     return out
 
 

@@ -36,7 +36,9 @@ def test_info_rates_and_largest_gap(tmp_path) -> None:
         for i in range(200):
             t = 10.0 + i * 0.025 + (0.5 if i >= 100 else 0.0)  # a 0.5 s hole after 2.5 s
             rec.put("/vehicle/imu", t, {"i": i})
-        rec.put("/gcs/events", t, LinkEvent(t, 1, LinkEventKind.LOST, "no heartbeat for 2.0 s"))
+        rec.put("/link/events", t, LinkEvent(t, 1, LinkEventKind.LOST, "no heartbeat for 2.0 s"))
+        rec.put("/link/events", t, LinkEvent(t, 1, LinkEventKind.REGAINED, "heartbeat"))
+        rec.put("/gcs/events", t, {"t_s": t, "level": 4, "text": "vehicle link LOST: holding"})
         rec.event(t, "warning", "LOST link")
         rec.event(t, "info", "armed")
     summary = summarize(open_recording(rec.path))
@@ -45,7 +47,8 @@ def test_info_rates_and_largest_gap(tmp_path) -> None:
     assert imu.max_gap_s == pytest.approx(0.525, abs=1e-6)
     assert imu.max_gap_at_s == pytest.approx(99 * 0.025, abs=1e-6)
     assert imu.rate_hz == pytest.approx(199 / (199 * 0.025 + 0.5), rel=1e-6)
-    assert [loss.topic for loss in summary.link_losses] == ["/gcs/events", "/log"]
+    assert [loss.topic for loss in summary.link_losses] == ["/link/events"]  # not repeated
+    assert summary.link_losses[0].text == "no heartbeat for 2.0 s"
     assert summary.connection == "udpin:0.0.0.0:14550"
 
 
@@ -106,3 +109,13 @@ def test_csv_cli(recorded_flight, tmp_path, capsys) -> None:
     out = tmp_path / "c"
     assert main(["logs", "export", str(path), "--csv", str(out), "--topic", "/gcs/estimate"]) == 0
     assert [p.name for p in Path(out).iterdir()] == ["gcs_estimate.csv"]
+
+
+def test_link_losses_from_station_events_and_log_lines(tmp_path) -> None:
+    with Recorder(tmp_path / "s.mcap", metadata={"url": "tcp:127.0.0.1:5760"}) as rec:
+        rec.put("/gcs/events", 1.0, {"t_s": 1.0, "level": 4, "text": "vehicle link LOST: hold"})
+        rec.put("/gcs/events", 2.0, {"t_s": 2.0, "level": 3, "text": "vehicle link regained"})
+        rec.event(3.0, "error", "LOST: no heartbeat")
+    summary = summarize(open_recording(rec.path))
+    assert [(loss.topic, loss.at_s) for loss in summary.link_losses] == [("/gcs/events", 0.0)]
+    assert summary.connection == "tcp:127.0.0.1:5760"
