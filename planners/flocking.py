@@ -371,7 +371,27 @@ class FlockPlanner:
             if self._guard_ok(k, sp, reserved):
                 return sp, primary_free
             self._wanted.setdefault(k, sp)
+        if k in self._wanted and cands:
+            return self._detour(k, p, cands[0][1], reading, reserved), primary_free
         return None, primary_free
+
+    def _detour(
+        self, k: int, p: Vec3, blocked: Vec3, reading: ProximityReading, reserved: list[Vec3]
+    ) -> Vec3 | None:
+        """Sidestep round a teammate that will not move (it has arrived or has priority)."""
+        s = self.params.step_m
+        best: Vec3 | None = None
+        best_gap = -math.inf
+        for d in AXIS_MOVES[:4]:
+            if abs(float(np.dot(d, blocked))) > 0.5 or not self._sensor_ok(reading, d, s):
+                continue
+            q = _add(p, d, s)
+            if not self._guard_ok(k, q, reserved):
+                continue
+            gap = min(_dist(q, r) for j, r in enumerate(reserved) if j != k)
+            if gap > best_gap:
+                best, best_gap = q, gap
+        return best
 
     def _avoid_direction(
         self, p: Vec3, target: Vec3, reading: ProximityReading, blocked: Vec3
