@@ -3,6 +3,10 @@
 from planners.astar import astar_search, plan_astar
 from planners.dstar_lite import DStarLite, run_dstar_lite
 from planners.epbha import Decision, Epbha, EpbhaParams, ObstacleClass, run_epbha
+from planners.flock_scenes import FlockScene
+from planners.flock_sim import FlockPlannerKind, FlockResult, run_flock
+from planners.flocking import FlockMission, FlockParams, FlockPlanner, FlockStep
+from planners.formation import Formation, FormationParams, Role
 from planners.geometry import Box, Vec3, World
 from planners.grid import Grid, GridParams
 from planners.kinematic import KinematicParams, KinematicSim, MoveOutcome
@@ -16,6 +20,15 @@ __all__ = [
     "Epbha",
     "EpbhaParams",
     "Facing",
+    "FlockMission",
+    "FlockParams",
+    "FlockPlanner",
+    "FlockPlannerKind",
+    "FlockResult",
+    "FlockScene",
+    "FlockStep",
+    "Formation",
+    "FormationParams",
     "Grid",
     "GridParams",
     "KinematicParams",
@@ -26,11 +39,13 @@ __all__ = [
     "PlanStatus",
     "ProximityParams",
     "ProximityReading",
+    "Role",
     "Vec3",
     "World",
     "astar_search",
     "plan_astar",
     "run_dstar_lite",
     "run_epbha",
+    "run_flock",
     "sense",
 ]
