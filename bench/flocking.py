@@ -2,7 +2,8 @@
 
 Prints one row per (scene, team size, planner): time to goal of the root leader and of the
 followers (mean / last), formation error, minimum separation, collisions, messages, throughput
-through the door, and how the run ended. Run: ``.venv/bin/python bench/flocking.py [sizes...]``.
+through the door, and how the run ended. Run from the repository root (``bench/planners.py``
+would shadow the package if run as a script): ``.venv/bin/python -m bench.flocking [sizes...]``.
 """
 
 from __future__ import annotations
