@@ -90,4 +90,4 @@ def plan_astar(
     for u in nodes[1:]:
         sim.move_to(grid.point(u))
     return PlanResult("A*", PlanStatus.REACHED, tuple(sim.path), evaluations, expansions, (cpu,),
-                      sim.min_clearance_m, sim.collisions)
+                      sim.min_clearance_m, sim.collisions, penetrations=sim.penetrations)

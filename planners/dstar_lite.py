@@ -233,4 +233,4 @@ def run_dstar_lite(
         sim.move_to(grid.point(nxt))
     return PlanResult("D* Lite", status, tuple(sim.path), planner.evaluations,
                       planner.expansions, tuple(cpu), sim.min_clearance_m, sim.collisions,
-                      detail)
+                      detail, sim.penetrations)

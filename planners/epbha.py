@@ -230,6 +230,7 @@ class Epbha:
     _manoeuvre: _Manoeuvre | None = None
     _visits: Counter[tuple[int, int, int]] = field(default_factory=Counter)
     _deadlocked: bool = False
+    _recoiled_from: Move | None = None
 
     def __post_init__(self) -> None:
         self.goal_n = tuple(float(c) for c in self.goal_n)  # type: ignore[assignment]
@@ -371,11 +372,15 @@ class Epbha:
 
         keep_off = self._keep_off(reading)
         if keep_off is not None:
+            self._recoiled_from = keep_off.opposite
             return self._decide(self._neighbour(pos, keep_off), Status.MOVING, Reason.KEEP_OFF,
                                 ObstacleClass.NONE, (), options)
 
+        # Just backed away from something on that side: going straight back would only
+        # oscillate, so that side counts as blocked once and the obstacle gets classified.
+        recoiled, self._recoiled_from = self._recoiled_from, None
         table = tuple(
-            CostEntry(m, n, self.cost(n), self._free(reading, m))
+            CostEntry(m, n, self.cost(n), self._free(reading, m) and m is not recoiled)
             for m in self.grid_moves()
             for n in (self._neighbour(pos, m),)
         )
@@ -602,4 +607,5 @@ def run_epbha(
         min_clearance_m=sim.min_clearance_m if math.isfinite(sim.min_clearance_m) else 0.0,
         collisions=sim.collisions,
         detail=detail,
+        penetrations=sim.penetrations,
     )

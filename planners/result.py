@@ -36,8 +36,9 @@ class PlanResult:
     node_expansions: int
     cpu_s_per_step: tuple[float, ...]
     min_clearance_m: float
-    collisions: int
+    collisions: int  # moves that came within the body radius of an obstacle or wall
     detail: str = ""
+    penetrations: int = 0  # moves whose segment went through an obstacle or out of the room
 
     @property
     def reached(self) -> bool:

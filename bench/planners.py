@@ -1,0 +1,152 @@
+"""EPBHA against A* (known map) and D* Lite (unknown map) on the thesis's scenes and random rooms.
+
+Run: .venv/bin/python bench/planners.py [--rooms 30] [--seed 0]
+
+Prints, per thesis scene, each planner's outcome, path length and its ratio to A*'s, cost
+evaluations, node expansions, CPU per step, minimum clearance and collisions; checks the floors
+(0 collisions everywhere, EPBHA reaches every goal with >= 10x fewer cost evaluations than
+D* Lite and a path <= 1.5x A*'s); then a summary over seeded random cluttered rooms with a
+breakdown of why EPBHA failed where it did. Exit status 1 when a thesis-scene floor fails.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import statistics
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from planners.astar import plan_astar
+from planners.dstar_lite import run_dstar_lite
+from planners.epbha import run_epbha
+from planners.result import PlanResult
+from planners.scenes import Scene, random_room, thesis_scenes
+
+MAX_STEPS = 3000
+PLANNERS: dict[str, Callable[[Scene], PlanResult]] = {
+    "EPBHA": lambda s: run_epbha(s.world, s.start_n, s.goal_n, max_steps=MAX_STEPS),
+    "A*": lambda s: plan_astar(s.world, s.start_n, s.goal_n),
+    "D* Lite": lambda s: run_dstar_lite(s.world, s.start_n, s.goal_n, max_steps=MAX_STEPS),
+}
+
+
+def run_all(scene: Scene) -> dict[str, PlanResult]:
+    """Every planner on one scene."""
+    return {name: plan(scene) for name, plan in PLANNERS.items()}
+
+
+def thesis_table() -> bool:
+    """Print the thesis-scene table and return True when every floor holds."""
+    header = (
+        f"{'scene':<16}{'planner':<9}{'status':<17}{'length m':>9}{'/A*':>6}"
+        f"{'cost evals':>11}{'expanded':>9}{'CPU/step ms':>12}{'min clr m':>10}{'coll':>5}"
+    )
+    print("Thesis scenes (Ch. 8), grid step 0.1 m, IR range 0.5 m, body radius 0.15 m")
+    print(header)
+    print("-" * len(header))
+    failures: list[str] = []
+    for scene in thesis_scenes():
+        results = run_all(scene)
+        astar = results["A*"]
+        for name, r in results.items():
+            ratio = r.path_length_m / astar.path_length_m if r.reached and astar.reached else 0.0
+            print(
+                f"{scene.name:<16}{name:<9}{r.status.value:<17}{r.path_length_m:>9.2f}"
+                f"{ratio:>6.2f}{r.cost_evaluations:>11}{r.node_expansions:>9}"
+                f"{r.cpu_mean_s_per_step * 1e3:>12.3f}{r.min_clearance_m:>10.3f}{r.collisions:>5}"
+            )
+            if r.collisions:
+                failures.append(f"{scene.name}: {name} collided {r.collisions} times")
+        epbha, dstar = results["EPBHA"], results["D* Lite"]
+        if not epbha.reached:
+            failures.append(f"{scene.name}: EPBHA did not reach the goal ({epbha.detail})")
+        elif astar.reached and epbha.path_length_m > 1.5 * astar.path_length_m:
+            failures.append(f"{scene.name}: EPBHA path is over 1.5x A*'s")
+        if epbha.cost_evaluations * 10 > dstar.cost_evaluations:
+            failures.append(f"{scene.name}: EPBHA uses under 10x fewer cost evaluations")
+    print()
+    if failures:
+        print("FLOORS FAILED:")
+        for f in failures:
+            print(f"  {f}")
+    else:
+        print(
+            "Floors hold: 0 collisions for every planner; EPBHA reaches every goal with >= 10x "
+            "fewer cost evaluations than D* Lite and a path <= 1.5x A*'s."
+        )
+    return not failures
+
+
+def random_summary(rooms: int, seed: int) -> None:
+    """Print success rate, length ratio, effort and EPBHA's failure breakdown over random rooms."""
+    rng = np.random.default_rng(seed)
+    per: dict[str, list[PlanResult]] = {name: [] for name in PLANNERS}
+    ratios: dict[str, list[float]] = {name: [] for name in PLANNERS}
+    breakdown: collections.Counter[str] = collections.Counter()
+    unreachable = 0
+    for _ in range(rooms):
+        scene = random_room(rng)
+        results = run_all(scene)
+        astar = results["A*"]
+        if not astar.reached:
+            unreachable += 1
+        for name, r in results.items():
+            per[name].append(r)
+            if r.reached and astar.reached:
+                ratios[name].append(r.path_length_m / astar.path_length_m)
+        epbha = results["EPBHA"]
+        if not epbha.reached:
+            cause = epbha.detail or epbha.status.value
+            where = "goal reachable" if astar.reached else "goal unreachable on the grid"
+            breakdown[f"{cause} ({where})"] += 1
+        elif epbha.collisions:
+            breakdown["reached, but grazed an obstacle within the body radius"] += 1
+    print()
+    print(f"Random cluttered rooms: {rooms} rooms, seed {seed} (30 % of boxes reach the ceiling)")
+    header = (
+        f"{'planner':<9}{'success':>9}{'len/A*':>8}{'cost evals':>12}{'CPU/step ms':>12}"
+        f"{'rooms w/ coll':>14}{'penetrating':>12}"
+    )
+    print(header)
+    print("-" * len(header))
+    for name, results in per.items():
+        reached = sum(r.reached for r in results)
+        cpu = [r.cpu_mean_s_per_step for r in results if r.cpu_s_per_step]
+        grazed = sum(1 for r in results if r.collisions)
+        through = sum(1 for r in results if r.penetrations)
+        print(
+            f"{name:<9}{reached:>4}/{len(results):<4}"
+            f"{statistics.mean(ratios[name]) if ratios[name] else 0.0:>8.2f}"
+            f"{statistics.mean(r.cost_evaluations for r in results):>12.0f}"
+            f"{statistics.mean(cpu) * 1e3 if cpu else 0.0:>12.3f}{grazed:>14}{through:>12}"
+        )
+    print(f"(goals A* proves unreachable on the grid: {unreachable})")
+    print("EPBHA outcomes other than a clean arrival:")
+    if not breakdown:
+        print("  none")
+    for cause, count in breakdown.most_common():
+        print(f"  {count:>3}  {cause}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rooms", type=int, default=30, help="random rooms to run (>= 0)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the random rooms")
+    args = parser.parse_args(argv)
+    if args.rooms < 0:
+        parser.error(f"--rooms must be >= 0, got {args.rooms}")
+    ok = thesis_table()
+    if args.rooms:
+        random_summary(args.rooms, args.seed)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
