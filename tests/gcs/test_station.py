@@ -27,7 +27,6 @@ from gcs.estimation import GRAVITY_MPS2
 from gcs.station import ControlMode, EventLevel, Station
 from gcs.thrust_curve import ThrottleCurve
 
-
 REST_M = 0.06  # the station's default vehicle geometry
 SONAR_BELOW_CG_M = 0.05
 
