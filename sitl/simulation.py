@@ -115,7 +115,8 @@ class VehicleRuntime:
             gyro_b=imu.gyro_b,
             acc_b=imu.acc_b,
             baro_alt_m=baro_alt,
-            sonar_m=sonar_m if sonar is not None else None,
+            sonar_m=sonar_m,
+            sonar_fresh=sonar is not None,
             battery_v=batt.voltage_v,
         )
         out = self.autopilot.update(sample, t, dt_s)

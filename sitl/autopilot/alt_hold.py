@@ -50,12 +50,32 @@ class AltitudeController:
         self._pid = Pid(gains.acc_z)
         self._pid._integrator = max(-gains.acc_z.imax, min(gains.acc_z.imax, integrator))
 
-    def reset(self, alt_cm: float, throttle_now: float) -> None:
-        """Start holding `alt_cm` without a throttle jump (integrator absorbs the difference)."""
-        self.target_alt_cm = alt_cm
+    def reset(self, alt_cm: float, throttle_now: float, vel_cms: float = 0.0) -> None:
+        """Start holding where a climb at `vel_cms` can stop (set_target_to_stopping_point_z),
+        without a throttle jump (the integrator absorbs the difference)."""
+        self.target_alt_cm = alt_cm + self._stopping_distance_cm(vel_cms)
         self._pid.reset()
         self._pid._integrator = (throttle_now - self.hover_throttle) * 1000.0
         self._acc_filtered = 0.0
+
+    def _stopping_distance_cm(self, vel_cms: float) -> float:
+        p = max(self.gains.pos_z_p, 1e-3)
+        linear_vel = ACCEL_Z_MAX_CMSS / p
+        if abs(vel_cms) <= linear_vel:
+            return vel_cms / p
+        linear_dist = ACCEL_Z_MAX_CMSS / (2.0 * p * p)
+        d = linear_dist + vel_cms * vel_cms / (2.0 * ACCEL_Z_MAX_CMSS)
+        return math.copysign(d, vel_cms)
+
+    def _sqrt_controller(self, error_cm: float) -> float:
+        """AC_PosControl's position → velocity: linear near the target, sqrt beyond."""
+        p = self.gains.pos_z_p
+        linear_dist = ACCEL_Z_MAX_CMSS / (2.0 * p * p) if p > 0 else 0.0
+        if error_cm > linear_dist:
+            return math.sqrt(2.0 * ACCEL_Z_MAX_CMSS * (error_cm - linear_dist / 2.0))
+        if error_cm < -linear_dist:
+            return -math.sqrt(2.0 * ACCEL_Z_MAX_CMSS * (-error_cm - linear_dist / 2.0))
+        return p * error_cm
 
     def update(
         self,
@@ -74,7 +94,9 @@ class AltitudeController:
         ):
             self.target_alt_cm += climb_rate_cms * dt_s
         self.target_alt_cm = min(alt_cm + LEASH_CM, max(alt_cm - LEASH_CM, self.target_alt_cm))
-        vel_target = g.pos_z_p * (self.target_alt_cm - alt_cm) + climb_rate_cms
+        vel_target = self._sqrt_controller(self.target_alt_cm - alt_cm) + climb_rate_cms
+        vmax = g.pilot_velz_max_cms
+        vel_target = min(vmax, max(-vmax, vel_target))
         acc_target = g.vel_z_p * (vel_target - vel_cms)
         acc_target = min(ACCEL_Z_MAX_CMSS, max(-ACCEL_Z_MAX_CMSS, acc_target))
         alpha = dt_s / (dt_s + 1.0 / (2.0 * math.pi * ACCEL_FILT_HZ))
@@ -139,8 +161,19 @@ class SurfaceTracker:
         """True once enough good reads arrived."""
         return self.health >= self.HEALTH_MAX and self.sonar_alt_cm is not None
 
-    def climb_rate(self, target_rate_cms: float, dt_s: float, gain: float) -> float:
-        """Pilot climb rate corrected to keep the surface distance."""
+    def climb_rate(
+        self,
+        target_rate_cms: float,
+        dt_s: float,
+        gain: float,
+        alt_target_cm: float,
+        alt_cm: float,
+    ) -> float:
+        """Pilot climb rate corrected to keep the surface distance.
+
+        As in 3.2.1, the part of the distance error the altitude controller is already
+        correcting (target altitude − altitude) is removed, so the two loops don't fight.
+        """
         if not self.healthy:
             self.target_cm = None
             return target_rate_cms
@@ -148,6 +181,9 @@ class SurfaceTracker:
         if self.target_cm is None:
             self.target_cm = self.sonar_alt_cm
         self.target_cm += target_rate_cms * dt_s
-        correction = (self.target_cm - self.sonar_alt_cm) * gain
-        correction = min(self.VELZ_MAX_CMS, max(-self.VELZ_MAX_CMS, correction))
+        self.target_cm = min(
+            self.sonar_alt_cm + LEASH_CM, max(self.sonar_alt_cm - LEASH_CM, self.target_cm)
+        )
+        error = (self.target_cm - self.sonar_alt_cm) - (alt_target_cm - alt_cm)
+        correction = min(self.VELZ_MAX_CMS, max(-self.VELZ_MAX_CMS, error * gain))
         return target_rate_cms + correction

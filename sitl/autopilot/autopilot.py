@@ -61,7 +61,8 @@ class SensorSample:
     gyro_b: tuple[float, float, float]
     acc_b: tuple[float, float, float]  # specific force, m/s²
     baro_alt_m: float | None = None  # new barometric altitude, up positive
-    sonar_m: float | None = None  # new sonar distance, None if no new echo
+    sonar_m: float | None = None  # sonar distance of a new reading, None if it had no echo
+    sonar_fresh: bool = False  # a sonar reading (with or without echo) arrived this tick
     battery_v: float = 12.6
 
 
@@ -112,7 +113,7 @@ class Autopilot:
         self.attitude = AttitudeController(self.gains)
         self.alt_ctrl = AltitudeController(self.gains, hover_throttle)
         self.surface = SurfaceTracker()
-        self.land = LandDetector()
+        self.land = LandDetector(climb_max_ms=0.4 if profile is Profile.APM25 else 1.0)
         self.gcs = GcsWatch()
         self.battery = BatteryWatch()
         self.state = AutopilotState()
@@ -122,6 +123,7 @@ class Autopilot:
         self._last_throttle = 0.0
         self._cal_sum = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
         self._cal_n = 0
+        self._acc_offset = (0.0, 0.0, 0.0)
         self.calibrated = False
         self._refresh_gains()
 
@@ -191,7 +193,9 @@ class Autopilot:
 
     def _enter_mode(self, mode: FlightMode) -> None:
         if mode in (FlightMode.ALT_HOLD, FlightMode.LAND):
-            self.alt_ctrl.reset(self.inav.alt_m * 100.0, self._last_throttle)
+            self.alt_ctrl.reset(
+                self.inav.alt_m * 100.0, self._last_throttle, self.inav.climb_ms * 100.0
+            )
         self.state.mode = mode
         self.state.hold_for_gcs = False
 
@@ -240,17 +244,22 @@ class Autopilot:
         g = self.gains
         if not self.calibrated:
             self._calibrate(s, t_s)
-        self.ahrs.update(s.gyro_b, s.acc_b, dt_s)
+        acc_b = (
+            s.acc_b[0] - self._acc_offset[0],
+            s.acc_b[1] - self._acc_offset[1],
+            s.acc_b[2] - self._acc_offset[2],
+        )
+        self.ahrs.update(s.gyro_b, acc_b, dt_s)
         roll, pitch, yaw = self.ahrs.euler()
         st.roll_rad, st.pitch_rad, st.yaw_rad = roll, pitch, yaw
         st.gyro_rads = self.ahrs.gyro_corrected
         tilt_cos = math.cos(roll) * math.cos(pitch)
-        f_n = self.ahrs.body_to_ned(s.acc_b)
+        f_n = self.ahrs.body_to_ned(acc_b)
         acc_up = -(f_n[2] + GRAVITY_MSS)
         if s.baro_alt_m is not None:
             self.inav.correct(s.baro_alt_m)
         self.inav.update(acc_up, dt_s)
-        if s.sonar_m is not None or st.mode is FlightMode.STABILIZE:
+        if s.sonar_fresh:
             self.surface.reading(s.sonar_m, tilt_cos, g)
 
         if self.profile is Profile.COPTER4:
@@ -297,12 +306,12 @@ class Autopilot:
             self.ahrs.set_gyro_offsets(
                 (self._cal_sum[0] / n, self._cal_sum[1] / n, self._cal_sum[2] / n)
             )
-            self.ahrs.level_from(
-                (self._cal_sum[3] / n, self._cal_sum[4] / n, self._cal_sum[5] / n), 0.0
-            )
             mean_acc = (self._cal_sum[3] / n, self._cal_sum[4] / n, self._cal_sum[5] / n)
-            # the owner's accelerometer calibration: the vertical offset seen at rest
-            self.inav.set_accel_offset(math.sqrt(sum(a * a for a in mean_acc)) - GRAVITY_MSS)
+            # The owner's accelerometer calibration and "calibrate level" (AHRS_TRIM): the
+            # vehicle boots standing level, so what the accelerometer reads beyond (0, 0, -g)
+            # at rest is its offset.
+            self._acc_offset = (mean_acc[0], mean_acc[1], mean_acc[2] + GRAVITY_MSS)
+            self.ahrs.level_from((0.0, 0.0, -GRAVITY_MSS), 0.0)
             self.calibrated = True
             self.texts.append((Severity.INFO, "Calibrating barometer"))
 
@@ -336,7 +345,13 @@ class Autopilot:
             if not st.armed or self.land.landed:
                 self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
                 return 0.0, t_roll, t_pitch, yaw_rate
-        climb = self.surface.climb_rate(climb, dt_s, self.gains.rng_gain)
+        climb = self.surface.climb_rate(
+            climb,
+            dt_s,
+            self.gains.rng_gain,
+            self.alt_ctrl.target_alt_cm,
+            self.inav.alt_m * 100.0,
+        )
         out = self.alt_ctrl.update(
             climb,
             self.inav.alt_m * 100.0,
