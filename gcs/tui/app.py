@@ -39,12 +39,12 @@ LIVE_BINDINGS = [
     Binding("h", "toggle_hold", "PC alt hold"),
     Binding("w", "throttle(1)", "Throttle up", show=False),
     Binding("s", "throttle(-1)", "Throttle down", show=False),
-    Binding("pageup,plus", "setpoint(1)", "Setpoint up", show=False),
-    Binding("pagedown,minus", "setpoint(-1)", "Setpoint down", show=False),
-    Binding("up", "stick('pitch', 1)", "Pitch forward", show=False),
-    Binding("down", "stick('pitch', -1)", "Pitch back", show=False),
-    Binding("left", "stick('roll', -1)", "Roll left", show=False),
-    Binding("right", "stick('roll', 1)", "Roll right", show=False),
+    Binding("pageup,plus", "setpoint(1)", "Setpoint up", show=False, priority=True),
+    Binding("pagedown,minus", "setpoint(-1)", "Setpoint down", show=False, priority=True),
+    Binding("up", "stick('pitch', 1)", "Pitch forward", show=False, priority=True),
+    Binding("down", "stick('pitch', -1)", "Pitch back", show=False, priority=True),
+    Binding("left", "stick('roll', -1)", "Roll left", show=False, priority=True),
+    Binding("right", "stick('roll', 1)", "Roll right", show=False, priority=True),
     Binding("q", "stick('yaw', -1)", "Yaw left", show=False),
     Binding("e", "stick('yaw', 1)", "Yaw right", show=False),
     ]
@@ -78,7 +78,7 @@ class TeleopApp(App[None]):
         self.backend = backend
         self._clock = clock
         self.sticks = Sticks()
-        self._messages_shown = 0
+        self._last_message_t = float("-inf")
         self._hold_on = False
         self.frozen = False  # tests freeze redraws before asserting on the screen
         self._help_text = describe([*type(self).BINDINGS, *COMMON_BINDINGS])
@@ -92,7 +92,9 @@ class TeleopApp(App[None]):
         with Horizontal(id="plots"):
             yield HeightPlot(id="height-plot")
             yield AccelPlot(id="accel-plot")
-        yield RichLog(id="messages", max_lines=500, wrap=False, markup=False)
+        log = RichLog(id="messages", max_lines=500, wrap=False, markup=False)
+        log.can_focus = False  # arrow keys are sticks, never scrolling
+        yield log
         yield Footer()
 
     def on_mount(self) -> None:
@@ -122,9 +124,11 @@ class TeleopApp(App[None]):
             panel.view = view  # type: ignore[attr-defined]
         self._hold_on = view.altitude.hold_on
         log = self.query_one("#messages", RichLog)
-        for t_s, text in view.messages[self._messages_shown :]:
-            log.write(Text(f"{t_s:8.1f}  {text}"))
-        self._messages_shown = len(view.messages)
+        for t_s, text in view.messages:
+            if t_s > self._last_message_t:
+                log.write(Text(f"{t_s:8.1f}  {text}"))
+        if view.messages:
+            self._last_message_t = max(self._last_message_t, view.messages[-1][0])
 
     def redraw_plots(self) -> None:
         """Redraw the two graphs (slower than the panels: plotext costs milliseconds)."""

@@ -10,6 +10,8 @@ from textual.containers import Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Static
 
+KEY_NAMES = {"question_mark": "?", "plus": "+", "minus": "-", "space": "space"}
+
 
 def describe(bindings: list[BindingType]) -> str:
     """One line per binding: keys, then what they do."""
@@ -19,7 +21,8 @@ def describe(bindings: list[BindingType]) -> str:
             keys, desc = b.key, b.description
         else:
             keys, desc = b[0], b[2] if len(b) > 2 else b[1]
-        rows.append(f"  {keys.replace(',', ' / '):<24} {desc}")
+        names = [KEY_NAMES.get(k, k) for k in keys.split(",")]
+        rows.append(f"  {' / '.join(names):<22} {desc}")
     return "\n".join(rows)
 
 

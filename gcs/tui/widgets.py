@@ -48,15 +48,14 @@ class LinkPanel(Panel):
         else:
             text.append("connecting…", style="yellow")
         text.append(f"  hb {fmt(link.heartbeat_age_s, '.1f', ' s')}\n")
-        text.append(f"{fmt(link.msgs_per_s, '.0f')} msg/s  ")
-        text.append(f"lost {link.rx_lost}  bad {link.rx_bad}\n")
+        text.append(f"{fmt(link.msgs_per_s, '.0f')}/s lost {link.rx_lost} bad {link.rx_bad}\n")
         text.append("signing ")
         text.append(_flag(link.signing, "on", "off"))
-        text.append(f"\nrec {link.recording or 'off'}\n")
-        text.append(
-            f"loop {fmt(loop.period_ms, '.1f')} ms  p99 jit {fmt(loop.jitter_p99_ms, '.2f')} ms\n"
-        )
-        text.append(f"cpu {fmt(loop.compute_ms, '.2f')} ms  overruns {loop.overruns}")
+        text.append("  rec ")
+        text.append(_flag(link.recording is not None, "on", "off"))
+        text.append("\n")
+        text.append(f"loop {fmt(loop.period_ms, '.1f')} jit99 {fmt(loop.jitter_p99_ms, '.2f')}\n")
+        text.append(f"cpu {fmt(loop.compute_ms, '.2f')} ms  ovr {loop.overruns}")
         return text
 
 
@@ -93,14 +92,14 @@ class AltitudePanel(Panel):
         text.append("hold ")
         text.append(_flag(a.hold_on, "ON", "off"))
         text.append(f"  sp {fmt(a.setpoint_m, '.2f', ' m')}\n")
-        text.append(f"fused {fmt(a.fused_m, '.3f', ' m')}\n", style="bold")
+        text.append(f"fused {fmt(a.fused_m, '.3f', ' m')}", style="bold")
+        text.append(f" ({fmt(a.truth_m, '.3f')})\n" if a.truth_m is not None else "\n",
+                    style="dim")
         text.append(f"sonar {fmt(a.sonar_m, '.3f', ' m')}\n")
         text.append(f"accel {fmt(a.accel_m, '.3f', ' m')}\n")
         text.append(f"climb {fmt(a.climb_mps, '+.2f', ' m/s')}\n")
         text.append(f"acc↑  {fmt(a.acc_up_mps2, '+.2f', ' m/s²')}\n")
         text.append(f"thr   {fmt(a.throttle_us, 'd', ' µs')}")
-        if a.truth_m is not None:
-            text.append(f"  truth {a.truth_m:.3f}", style="dim")
         return text
 
 

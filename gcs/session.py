@@ -1,0 +1,173 @@
+"""Bring a station up against a vehicle (or the bundled SITL) and take it down again.
+
+Every command that flies (`fly`, `teleop`, `mission run`) needs the same steps: start the SITL
+when no `--connect` is given, open a recorder per vehicle, open the link with the raw tap on the
+recorder, bring the telemetry streams up, read the throttle-curve parameters, open motion capture
+and build a `Station`. `StationSession` does them in order and undoes them in reverse, whatever
+happens in between: overrides released, links closed, files finished, the SITL stopped.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from firmware_link import LinkError, LinkUsageError, MocapLink, VehicleLink, load_signing_key
+from firmware_link.records import Dialect, MocapPose
+from gcs.clock import Clock, MonotonicClock, ScaledClock
+from gcs.config import load_config
+from gcs.errors import UsageError
+from gcs.sitl_process import SitlOptions, SitlProcess
+from gcs.station import Station
+from gcs.thrust_curve import ThrottleCurve
+
+CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
+STREAM_RATE_HZ = 40.0
+
+
+@dataclass(frozen=True, slots=True)
+class SessionOptions:
+    """What to connect to and how; the CLI fills it from its flags."""
+
+    command: str
+    connect: str | None = None  # None: start the bundled SITL
+    mocap: str | None = None
+    profile: str = "apm25"
+    world: Path | None = None
+    serial: bool = False
+    speedup: float = 1.0
+    seed: int | None = None
+    config: Path | None = None
+    signing_key: Path | None = None
+    record: bool = True
+    output: Path = Path("flights")
+    sysids: tuple[int, ...] = (1,)
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    def validate(self) -> None:
+        """Reject impossible combinations with one line each."""
+        if not 0 < self.speedup <= 50:
+            raise UsageError(f"--speedup {self.speedup}: expected 0 < speedup <= 50")
+        if self.world is not None and not self.world.is_file():
+            raise UsageError(f"--world {self.world}: no such file")
+        if self.connect is not None and len(self.sysids) > 1:
+            raise UsageError("--connect flies one vehicle; several need the bundled SITL")
+
+
+class MocapFor:
+    """One vehicle's view of a motion-capture stream that tracks several bodies."""
+
+    def __init__(self, link: MocapLink, sysid: int) -> None:
+        self.link = link
+        self.sysid = sysid
+
+    def poll(self) -> list[MocapPose]:
+        """Poses of this vehicle only."""
+        return [p for p in self.link.poll() if p.sysid == self.sysid]
+
+
+@dataclass(slots=True)
+class Vehicle:
+    """One connected vehicle: its link, station and recorder."""
+
+    sysid: int
+    url: str
+    link: VehicleLink
+    station: Station
+    recorder: Any | None
+
+
+class StationSession:
+    """Context manager: the vehicles' stations, built but not started."""
+
+    def __init__(self, options: SessionOptions) -> None:
+        options.validate()
+        self.options = options
+        self.clock: Clock = (
+            MonotonicClock() if options.speedup == 1.0 else ScaledClock(options.speedup)
+        )
+        self.vehicles: dict[int, Vehicle] = {}
+        self.sitl_endpoints: Any = None
+        self._stack = contextlib.ExitStack()
+
+    def __enter__(self) -> StationSession:
+        try:
+            self._open()
+        except BaseException:
+            self._stack.close()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stack.close()
+
+    @property
+    def first(self) -> Vehicle:
+        """The vehicle of a single-vehicle session."""
+        return self.vehicles[self.options.sysids[0]]
+
+    def _key(self) -> bytes | None:
+        path = self.options.signing_key
+        if path is None:
+            return None
+        try:
+            return load_signing_key(path)
+        except (LinkUsageError, OSError, ValueError) as exc:
+            raise UsageError(f"--signing-key {path}: {exc}") from None
+
+    def _open(self) -> None:
+        o = self.options
+        key = self._key()
+        config = load_config(o.config)
+        urls: dict[int, str] = {}
+        mocap_url = o.mocap
+        if o.connect is None:
+            sitl = SitlProcess(SitlOptions(profile=o.profile, world=o.world,
+                                           vehicles=max(o.sysids), speedup=o.speedup,
+                                           serial=o.serial, seed=o.seed,
+                                           signing_key=o.signing_key))
+            self.sitl_endpoints = sitl.start()
+            self._stack.callback(sitl.stop)
+            urls = {s: self.sitl_endpoints.url(s, serial=o.serial) for s in o.sysids}
+            mocap_url = mocap_url or self.sitl_endpoints.mocap
+        else:
+            urls = {o.sysids[0]: o.connect}
+        for sysid, url in urls.items():
+            self.vehicles[sysid] = self._open_vehicle(sysid, url, mocap_url, key, config)
+
+    def _open_vehicle(self, sysid: int, url: str, mocap_url: str | None, key: bytes | None,
+                      config: Any) -> Vehicle:
+        o = self.options
+        recorder = None
+        if o.record:
+            from logs import Recorder, RecordingError
+
+            meta = {"command": o.command, "url": url, "vehicle": str(sysid),
+                    "profile": o.profile, **{k: str(v) for k, v in o.metadata.items()}}
+            try:
+                recorder = Recorder(o.output, metadata=meta, vehicle=f"vehicle{sysid}")
+            except RecordingError as exc:
+                raise UsageError(f"-o {o.output}: {exc}") from None
+            self._stack.callback(recorder.close)
+        link = VehicleLink.open(url, signing_key=key, clock=self.clock.now_s,
+                                target_system=sysid if o.connect is None else None,
+                                on_raw=recorder.put_raw if recorder is not None else None)
+        self._stack.callback(link.close)
+        link.bring_up(STREAM_RATE_HZ)
+        params: dict[str, float] = {}
+        for name in CURVE_PARAMS.get(link.dialect, ()):
+            with contextlib.suppress(LinkError):
+                params[name] = link.get_param(name)
+        curve = ThrottleCurve.for_dialect(link.dialect, params)
+        mocap = None
+        if mocap_url is not None:
+            mocap_link = MocapLink.open(mocap_url, clock=self.clock.now_s)
+            self._stack.callback(mocap_link.close)
+            mocap = MocapFor(mocap_link, sysid)
+        station = Station(link, config=config, curve=curve, mocap=mocap, recorder=recorder,
+                          clock=self.clock)
+        # registered last, so it stops first: the loop releases overrides before links close
+        self._stack.callback(station.stop)
+        return Vehicle(sysid=sysid, url=url, link=link, station=station, recorder=recorder)
