@@ -93,8 +93,16 @@ def _null_non_finite(value: Any) -> Any:
     return value
 
 
-def _schema_for_hint(hint: Any) -> dict[str, Any]:
-    """JSON Schema of one field from its Python type hint."""
+_NUMBER: dict[str, Any] = {"type": "number"}
+
+
+def _schema_for_hint(hint: Any, value: Any) -> dict[str, Any]:
+    """JSON Schema of one field from its type hint, falling back on its (JSON-ready) value.
+
+    Only what Foxglove's JSON Schema reader accepts: one `type` per field (no `["number",
+    "null"]`: a null still decodes, the schema only names the field's kind), objects always with
+    `properties`, array items always typed.
+    """
     origin = typing.get_origin(hint)
     if hint is bool:
         return {"type": "boolean"}
@@ -105,42 +113,45 @@ def _schema_for_hint(hint: Any) -> dict[str, Any]:
     if hint is int:
         return {"type": "integer"}
     if hint is float:
-        return {"type": ["number", "null"]}
+        return dict(_NUMBER)
     if hint is str:
         return {"type": "string"}
-    if hint is bytes:
-        return {"type": "array", "items": {"type": "integer"}}
     if isinstance(hint, type) and dataclasses.is_dataclass(hint):
-        return schema_for_dataclass(hint)
+        return schema_for_dataclass(hint, value if isinstance(value, Mapping) else None)
     if origin is tuple or origin is list:
         n = _fixed_float_tuple_len(hint)
         if n:
             keys = VEC3_KEYS if n == 3 else QUAT_KEYS
-            return {
-                "type": "object",
-                "properties": {k: {"type": ["number", "null"]} for k in keys},
-            }
+            return {"type": "object", "properties": {k: dict(_NUMBER) for k in keys}}
         args = [a for a in typing.get_args(hint) if a is not Ellipsis]
-        item = _schema_for_hint(args[0]) if len(set(args)) == 1 else {}
-        return {"type": "array", "items": item}
-    if origin is dict or hint is dict:
-        return {"type": "object"}
+        first = value[0] if isinstance(value, list) and value else None
+        item = _schema_for_hint(args[0], first) if len(set(args)) == 1 else None
+        return {"type": "array", "items": _array_item(item, first)}
     if origin in (typing.Union, types.UnionType):
-        args = typing.get_args(hint)
-        non_none = [a for a in args if a is not type(None)]
+        non_none = [a for a in typing.get_args(hint) if a is not type(None)]
         if len(non_none) == 1:
-            inner = dict(_schema_for_hint(non_none[0]))
-            kind = inner.get("type")
-            if isinstance(kind, str):
-                inner["type"] = [kind, "null"]
-            return inner
-    return {}
+            return _schema_for_hint(non_none[0], value)
+    return schema_for_value(value)
 
 
-def schema_for_dataclass(cls: type) -> dict[str, Any]:
-    """JSON Schema (object) from a dataclass's field types."""
+def _array_item(item: dict[str, Any] | None, first: Any) -> dict[str, Any]:
+    """Foxglove reads arrays of scalars or objects only; anything else is described as text."""
+    if item is None:
+        item = schema_for_value(first)
+    if item.get("type") in ("boolean", "string", "number", "integer", "object"):
+        if item.get("type") == "string":
+            item = {k: v for k, v in item.items() if k != "contentEncoding"}
+        return item
+    return {"type": "string", "description": "nested array"}
+
+
+def schema_for_dataclass(cls: type, sample: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """JSON Schema (object) from a dataclass's field types; `sample` settles untyped fields."""
     hints = _hints(cls)
-    props = {f.name: _schema_for_hint(hints.get(f.name)) for f in dataclasses.fields(cls)}
+    props = {
+        f.name: _schema_for_hint(hints.get(f.name), sample.get(f.name) if sample else None)
+        for f in dataclasses.fields(cls)
+    }
     schema: dict[str, Any] = {"type": "object", "title": cls.__name__, "properties": props}
     if cls.__doc__:
         schema["description"] = cls.__doc__.strip().splitlines()[0]
@@ -154,7 +165,7 @@ def schema_for_value(value: Any) -> dict[str, Any]:
     if isinstance(value, int):
         return {"type": "integer"}
     if isinstance(value, float) or value is None:
-        return {"type": ["number", "null"]}
+        return dict(_NUMBER)
     if isinstance(value, str):
         return {"type": "string"}
     if isinstance(value, Mapping):
@@ -163,15 +174,16 @@ def schema_for_value(value: Any) -> dict[str, Any]:
             "properties": {str(k): schema_for_value(v) for k, v in value.items()},
         }
     if isinstance(value, list):
-        return {"type": "array", "items": schema_for_value(value[0]) if value else {}}
-    return {}
+        first = value[0] if value else None
+        return {"type": "array", "items": _array_item(None, first)}
+    return {"type": "string"}
 
 
 def schema_for_payload(payload: Any, jsonable: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
     """(schema name, JSON Schema) for a topic's first payload."""
     if dataclasses.is_dataclass(payload) and not isinstance(payload, type):
         cls = type(payload)
-        return f"{cls.__module__}.{cls.__qualname__}", schema_for_dataclass(cls)
+        return f"{cls.__module__}.{cls.__qualname__}", schema_for_dataclass(cls, jsonable)
     schema = schema_for_value(dict(jsonable))
     return "", schema
 

@@ -115,7 +115,7 @@ _CUBE = {
     "title": "foxglove.CubePrimitive",
     "properties": {"pose": _POSE, "size": _VEC3, "color": _COLOR},
 }
-_EMPTY_LIST = {"type": "array", "items": {"type": "object"}}
+_EMPTY_LIST = {"type": "array", "items": {"type": "object", "properties": {}}}
 
 
 def _object(title: str, properties: dict[str, Any]) -> dict[str, Any]:

@@ -71,3 +71,15 @@ def test_info_replay_and_plot_on_the_flight(sitl_flight, tmp_path, capsys) -> No
     assert lines[-1].startswith("replayed ")
     pytest.importorskip("matplotlib")
     assert main(["logs", "plot", str(sitl_flight), "-o", str(tmp_path / "f.png")]) == 0
+
+
+def test_every_schema_of_the_real_flight_is_foxglove_readable(sitl_flight) -> None:
+    from mcap.reader import make_reader
+
+    from tests.logs.foxglove_schema_check import foxglove_schema_problems
+
+    with open(sitl_flight, "rb") as f:
+        summary = make_reader(f).get_summary()
+    for schema in summary.schemas.values():
+        assert schema.encoding == "jsonschema"
+        assert foxglove_schema_problems(json.loads(schema.data)) == [], schema.name
