@@ -18,6 +18,8 @@ import numpy as np
 from planners.geometry import Vec3, World
 from planners.proximity import ProximityParams, ProximityReading, sense
 
+_EPS_M = 1e-9  # passing exactly at the body radius is not a collision, whatever the rounding
+
 
 @dataclass(frozen=True, slots=True)
 class KinematicParams:
@@ -69,13 +71,13 @@ class KinematicSim:
         target = (float(target_n[0]), float(target_n[1]), float(target_n[2]))
         if target == self.pos_n:
             c = self.world.clearance(target)
-            return MoveOutcome(target, c, c < self.params.body_radius_m, c == 0.0)
+            return MoveOutcome(target, c, c < self.params.body_radius_m - _EPS_M, c == 0.0)
         clearance = self.world.segment_clearance(self.pos_n, target)
         penetrated = (
             self.world.segment_hits_obstacle(self.pos_n, target) is not None
             or not self.world.in_room(target)
         )
-        collided = penetrated or clearance < self.params.body_radius_m
+        collided = penetrated or clearance < self.params.body_radius_m - _EPS_M
         self.collisions += int(collided)
         self.penetrations += int(penetrated)
         self.min_clearance_m = min(self.min_clearance_m, clearance)

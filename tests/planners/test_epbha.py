@@ -156,3 +156,78 @@ def test_thesis_scenes_are_reached_without_collisions(scene: Scene) -> None:
     assert math.dist(r.path[-1], scene.goal_n) <= 0.1
     assert r.cost_evaluations <= 4 * r.steps
     assert len(r.cpu_s_per_step) == r.steps + 1
+
+
+def test_after_keeping_off_it_does_not_step_straight_back() -> None:
+    p = planner()
+    d1 = p.step(START, reading(front=0.2))
+    assert d1.reason is Reason.KEEP_OFF and d1.next_pos_n == pytest.approx((-0.1, 0.0, -1.0))
+    # Back at 0.3 m the front is formally free, but it has just recoiled from it.
+    d2 = p.step(d1.next_pos_n, reading(front=0.36))
+    assert d2.reason is Reason.GO_AROUND and d2.obstacle is ObstacleClass.SINGLE_SIDED
+
+
+def test_overhead_seen_with_a_wing_is_a_cave() -> None:
+    d = planner().step(START, reading(front=0.3, right=0.4, up=0.45))
+    assert d.obstacle is ObstacleClass.CAVE and d.reason is Reason.BACK_OFF
+
+
+def test_partition_whose_climb_is_blocked_goes_around_instead() -> None:
+    p = planner()
+    d = p.step(START, reading(front=0.3, right=0.4))
+    assert d.reason is Reason.PASS_OVER
+    d = p.step(d.next_pos_n, reading(front=0.3, right=0.4, up=0.33))
+    # Goal dead ahead and the right side has a wing: around on the left (west, -y).
+    assert d.reason is Reason.GO_AROUND and d.next_pos_n[1] < 0.0
+
+
+def test_pass_along_reaches_the_face_that_blocked_the_way() -> None:
+    # Descending onto a table top 0.3 m below: step aside until the down cone is clear, then
+    # keep descending at least 0.3 m + body radius even where no side cone sees the table.
+    p = Epbha(EpbhaParams(), (0.0, 0.0, -0.2), START)
+    p.plane = Plane.YZ
+    pos = START
+    d = p.step(pos, reading(down=0.3))
+    assert d.reason is Reason.GO_AROUND
+    while d.reason is Reason.GO_AROUND:
+        pos = d.next_pos_n
+        d = p.step(pos, reading(down=0.3) if pos[1] < 0.25 else ProximityReading.clear())
+    descended = 0
+    while d.reason is Reason.PASS_ALONG:
+        descended += 1
+        d = p.step(d.next_pos_n, ProximityReading.clear())
+    assert descended * 0.1 >= 0.3 + 0.17 - 1e-9
+
+
+def test_run_epbha_reports_a_deadlock_in_a_closed_cell() -> None:
+    from planners.geometry import Box, World
+
+    room = Box("room", (0.0, 0.0, -2.0), (3.0, 3.0, 0.0))
+    cell = World(room, (
+        Box("n", (1.7, 1.0, -2.0), (1.8, 2.0, 0.0)),
+        Box("s", (1.2, 1.0, -2.0), (1.3, 2.0, 0.0)),
+        Box("e", (1.2, 1.7, -2.0), (1.8, 1.8, 0.0)),
+        Box("w", (1.2, 1.2, -2.0), (1.8, 1.3, 0.0)),
+        Box("lid", (1.2, 1.2, -1.8), (1.8, 1.8, -1.7)),
+    ))
+    r = run_epbha(cell, (1.5, 1.5, -1.0), (2.5, 1.5, -1.0), max_steps=500)
+    assert r.status is PlanStatus.DEADLOCK and r.detail.startswith("deadlock")
+    assert r.penetrations == 0 and r.collisions == 0
+
+
+def test_run_epbha_stops_at_max_steps() -> None:
+    scene = thesis_scenes()[0]
+    r = run_epbha(scene.world, scene.start_n, scene.goal_n, max_steps=5)
+    assert r.status is PlanStatus.MAX_STEPS and r.steps == 5
+
+
+def test_noisy_sensors_still_reach_the_thesis_scenes() -> None:
+    import numpy as np
+
+    from planners.proximity import ProximityParams
+
+    for scene in thesis_scenes():
+        r = run_epbha(scene.world, scene.start_n, scene.goal_n,
+                      proximity=ProximityParams(noise_sigma_m=0.01),
+                      rng=np.random.default_rng(7))
+        assert r.reached and r.collisions == 0, scene.name
