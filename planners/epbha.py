@@ -42,9 +42,14 @@ Where this code departs from the text, and why:
   any side is first backed away from. Manoeuvres continue a few steps beyond the step where an
   edge leaves the sensor cone, because a 22.5° half-cone stops seeing an edge at lateral offset
   seen·tan 22.5°, before the body (radius `body_radius_m`) has cleared it.
+- Going around, the thesis moves sideways until the way is clear and then on; a side cone does
+  not see a table top it is passing (the edge sits in the gap between cones), so passing
+  alongside continues at least as far as the face that blocked the way, plus the body radius.
 - The thesis keeps no memory; a purely reactive rule can cycle forever (re-entering a cave it
-  just left). The planner counts visits per grid cell and reports a deadlock (loop) instead of
-  cycling, and after a cave it climbs above the lid height it measured before moving on.
+  just left, or stepping back toward an edge it just backed away from). The planner counts
+  visits per grid cell and reports a deadlock (loop) instead of cycling; after a cave it climbs
+  above the lid height it measured before moving on; and right after a keep-off step the side
+  it backed away from counts as blocked once, so the obstacle is classified and avoided.
 """
 
 from __future__ import annotations
@@ -223,18 +228,23 @@ class Epbha:
     params: EpbhaParams
     goal_n: Vec3
     start_n: Vec3
-    plane: Plane = Plane.XY
-    heading: Move | None = None
-    cost_evaluations: int = 0
-    _prev_n: Vec3 | None = None
-    _manoeuvre: _Manoeuvre | None = None
-    _visits: Counter[tuple[int, int, int]] = field(default_factory=Counter)
-    _deadlocked: bool = False
-    _recoiled_from: Move | None = None
+    plane: Plane = field(default=Plane.XY, init=False)
+    heading: Move | None = field(default=None, init=False)  # Subfunction 1, from the last move
+    cost_evaluations: int = field(default=0, init=False)  # cost table entries so far
+    _prev_n: Vec3 | None = field(default=None, init=False, repr=False)
+    _manoeuvre: _Manoeuvre | None = field(default=None, init=False, repr=False)
+    _visits: Counter[tuple[int, int, int]] = field(
+        default_factory=Counter, init=False, repr=False
+    )
+    _deadlocked: bool = field(default=False, init=False, repr=False)
+    _recoiled_from: Move | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self.goal_n = tuple(float(c) for c in self.goal_n)  # type: ignore[assignment]
-        self.start_n = tuple(float(c) for c in self.start_n)  # type: ignore[assignment]
+        for name in ("goal_n", "start_n"):
+            v = tuple(float(c) for c in getattr(self, name))
+            if len(v) != 3 or not all(math.isfinite(c) for c in v):
+                raise ValueError(f"EPBHA {name} must be 3 finite NED coordinates, got {v}")
+            setattr(self, name, v)
 
     # --- grid -------------------------------------------------------------------------
 
