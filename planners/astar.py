@@ -71,7 +71,10 @@ def plan_astar(
     grid_params: GridParams | None = None,
     cpu_clock: Callable[[], float] = time.process_time,
 ) -> PlanResult:
-    """Plan on the fully known map and fly the plan in the kinematic world."""
+    """Plan on the fully known map and fly the plan in the kinematic world.
+
+    The plan is one step: its CPU time includes building the occupancy grid.
+    """
     t0 = cpu_clock()
     grid = Grid(world, start_n, grid_params)
     start, goal = grid.nearest(start_n), grid.nearest(goal_n)

@@ -9,6 +9,7 @@ nearest return, as an IR ranger reports the strongest (nearest) echo in its fiel
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from dataclasses import dataclass
 
@@ -189,13 +190,6 @@ def sense(
     return ProximityReading.from_facings(values, yaw_rad)
 
 
-_RAY_CACHE: dict[tuple[Facing, ProximityParams], list[Vec3]] = {}
-
-
-def _rays_for(facing: Facing, params: ProximityParams) -> list[Vec3]:
-    key = (facing, params)
-    rays = _RAY_CACHE.get(key)
-    if rays is None:
-        rays = cone_rays_b(facing, params)
-        _RAY_CACHE[key] = rays
-    return rays
+@functools.lru_cache(maxsize=64)
+def _rays_for(facing: Facing, params: ProximityParams) -> tuple[Vec3, ...]:
+    return tuple(cone_rays_b(facing, params))
