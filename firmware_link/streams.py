@@ -16,6 +16,7 @@ measure the ATTITUDE rate reached (100 ms is too short to count a 10 Hz stream).
 from __future__ import annotations
 
 import enum
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -210,14 +211,37 @@ def bring_up_periods_ms(
     return tuple(start_ms - (start_ms - end_ms) * k / steps for k in range(steps + 1))
 
 
-def step_plan(plan: StreamPlan, period_ms: float, *, whole_hz: bool) -> dict[str, float]:
-    """Per-message rates for one bring-up step: the plan, capped at 1/period."""
-    cap_hz = 1000.0 / period_ms
-    out: dict[str, float] = {}
-    for r in plan.rates:
-        hz = min(r.rate_hz, cap_hz)
-        out[r.message] = float(max(1, round(hz))) if whole_hz else hz
-    return out
+def step_plan(
+    plan: StreamPlan, period_ms: float, *, whole_hz: bool, limit_hz: float = math.inf
+) -> dict[str, float]:
+    """Per-message rates for one bring-up step: the plan, capped at 1/period and `limit_hz`.
+
+    With `whole_hz` (REQUEST_DATA_STREAM) the step rate is rounded to whole Hz and the budget
+    limit rounded down, so a limited rate still fits.
+    """
+    step_hz = 1000.0 / period_ms
+    if whole_hz:
+        step_hz = float(round(step_hz))
+        limit_hz = float(math.floor(limit_hz)) if math.isfinite(limit_hz) else limit_hz
+    cap_hz = max(1.0, min(step_hz, limit_hz))
+    return {r.message: min(r.rate_hz, cap_hz) for r in plan.rates}
+
+
+def fast_rate_limit_hz(
+    rx_bytes_per_s: float, fast_bytes_per_s: float, step_rate_hz: float, budget_bytes_per_s: float
+) -> float:
+    """Fastest common rate for the fast streams that keeps the link inside its budget.
+
+    Measured during one bring-up step: everything the link carried (`rx_bytes_per_s`) and the
+    part that runs at the step's rate (`fast_bytes_per_s`, including any traffic the plan did
+    not know of that scales with it, e.g. an extra message in a stream group). The rest stays
+    as it is when the fast streams speed up: budget = rest + fast bytes per cycle × rate.
+    """
+    if fast_bytes_per_s <= 0 or step_rate_hz <= 0:
+        return math.inf
+    per_cycle = fast_bytes_per_s / step_rate_hz
+    rest = max(0.0, rx_bytes_per_s - fast_bytes_per_s)
+    return max(0.0, (budget_bytes_per_s - rest) / per_cycle)
 
 
 @dataclass(frozen=True, slots=True)
@@ -239,7 +263,9 @@ class BringUpReport:
     steps: tuple[BringUpStep, ...]
     achieved_hz: tuple[tuple[str, float], ...]
     target_rate_hz: float
-    reached: bool  # ATTITUDE within the tolerance of the target at the last step
+    reached: bool  # ATTITUDE measured within the tolerance of the target rate
+    confirmed: bool = True  # ATTITUDE measured within the tolerance of the rate last asked
+    limit_hz: float | None = None  # fast-stream rate the measured link budget allowed
 
     def achieved(self, message: str) -> float:
         """Rate measured for `message` over the final window (0 when none arrived)."""
@@ -258,7 +284,13 @@ class BringUpReport:
             lines.append(
                 f"  achieved {name:<18}{hz:6.1f} Hz (planned {self.plan.rate_of(name):.1f})"
             )
-        lines.append("  target reached" if self.reached else "  target NOT reached")
+        if self.limit_hz is not None:
+            lines.append(f"  link budget measured: fast streams limited to {self.limit_hz:.1f} Hz")
+        if self.reached:
+            lines.append("  target reached")
+        else:
+            asked = "confirmed" if self.confirmed else "NOT confirmed"
+            lines.append(f"  target NOT reached; rate asked {asked}")
         return lines
 
 

@@ -44,6 +44,7 @@ from firmware_link.streams import (
     DataStream,
     StreamPlan,
     bring_up_periods_ms,
+    fast_rate_limit_hz,
     measured_rate_hz,
     plan_streams,
     step_plan,
@@ -73,6 +74,7 @@ RC_MIN_US = 1000
 RC_MAX_US = 2000
 RC_RELEASE = 0
 RC_LEAVE_ALONE = 65535
+PLAN_UTILISATION = 0.8  # share of a serial link the telemetry may fill; the rest is headroom
 SIGNING_ON = "MAVLink 2 signing on: outgoing frames signed, unsigned frames refused"
 
 
@@ -139,6 +141,7 @@ class VehicleLink:
         self._connecting: socket.socket | None = None
         self._stream_rates: dict[str, float] = {}
         self._rate_probe: dict[str, list[float]] | None = None
+        self._byte_probe: dict[str, int] = {}
         self._last_plan: StreamPlan | None = None
 
     # ------------------------------------------------------------------ opening
@@ -351,6 +354,7 @@ class VehicleLink:
         kind = msg.get_type()
         if self._rate_probe is not None and msg.get_srcComponent() == self._target_component:
             self._rate_probe.setdefault(kind, []).append(now)
+            self._byte_probe[kind] = self._byte_probe.get(kind, 0) + len(msg.get_msgbuf())
         if kind == "PARAM_VALUE":
             self._param_types[text_field(msg.param_id)] = int(msg.param_type)
         for record in self._convert.convert(msg, now):
@@ -684,6 +688,7 @@ class VehicleLink:
             wire=DIALECT_WIRE.get(self._dialect, self._ep.wire),
             signed=self._signing,
             grouped=self._dialect is Dialect.APM25,
+            max_utilisation=PLAN_UTILISATION,
         )
 
     def _request_rates(self, rates: dict[str, float]) -> None:
@@ -716,53 +721,79 @@ class VehicleLink:
         settle_s: float = 0.15,
         tolerance: float = 0.1,
     ) -> BringUpReport:
-        """Raise the telemetry rates in five steps to `target_rate_hz` and measure them."""
+        """Raise the telemetry rates in five steps to `target_rate_hz` and measure them.
+
+        On a link with a capacity, each step also measures the bytes the link really carries;
+        if the fast streams would not fit at the next step (the vehicle sends more than the
+        plan knows of), the remaining steps stop at the fastest rate that fits.
+        """
         if not 10.0 <= target_rate_hz <= 100.0:
             raise LinkUsageError(f"target rate {target_rate_hz} Hz outside 10..100 Hz")
         plan = self.plan(target_rate_hz)
         self._last_plan = plan
         whole_hz = self._dialect is Dialect.APM25
-        steps = []
-        periods = bring_up_periods_ms(100.0, 1000.0 / target_rate_hz, 5)
+        capacity = self.capacity_bytes_per_s
+        budget = None if capacity is None else capacity * PLAN_UTILISATION
+        slowest_fast_hz = max(
+            (r.rate_hz for r in plan.rates if r.rate_hz < target_rate_hz), default=0.0
+        )
+        limit_hz = math.inf
+        steps: list[BringUpStep] = []
         measured: dict[str, list[float]] = {}
+        periods = bring_up_periods_ms(100.0, 1000.0 / target_rate_hz, 5)
         for k, period in enumerate(periods):
-            rates = step_plan(plan, period, whole_hz=whole_hz)
+            rates = step_plan(plan, period, whole_hz=whole_hz, limit_hz=limit_hz)
             self._request_rates(rates)
             self._hold(settle_s)
-            last = k == len(periods) - 1
-            window = final_window_s if last else step_hold_s
+            window = final_window_s if k == len(periods) - 1 else step_hold_s
             self._rate_probe = measured = {}
+            self._byte_probe = {}
             bytes_before, t_before = self._ep.tally.rx_bytes, self._clock()
             try:
                 self._hold(window)
             finally:
                 self._rate_probe = None
             elapsed = max(self._clock() - t_before, 1e-9)
-            steps.append(
-                BringUpStep(
-                    period_ms=period,
-                    requested_hz=rates.get("ATTITUDE", 0.0),
-                    measured_hz=measured_rate_hz(measured.get("ATTITUDE", []), window),
-                    rx_bytes_per_s=(self._ep.tally.rx_bytes - bytes_before) / elapsed,
-                )
+            step = BringUpStep(
+                period_ms=period,
+                requested_hz=rates.get("ATTITUDE", 0.0),
+                measured_hz=measured_rate_hz(measured.get("ATTITUDE", []), window),
+                rx_bytes_per_s=(self._ep.tally.rx_bytes - bytes_before) / elapsed,
             )
+            steps.append(step)
+            # Estimate only once the fast streams clearly outrun the slow ones (their rates
+            # tell them apart), and trust the latest, fastest step most.
+            last_step = k == len(periods) - 1
+            if not last_step and budget is not None and step.requested_hz >= 1.5 * slowest_fast_hz:
+                fast_bytes = sum(
+                    self._byte_probe.get(kind, 0)
+                    for kind, stamps in measured.items()
+                    if len(stamps) / elapsed >= 0.75 * step.requested_hz
+                )
+                limit_hz = fast_rate_limit_hz(
+                    step.rx_bytes_per_s, fast_bytes / elapsed, step.requested_hz, budget
+                )
         achieved = tuple(
             (r.message, measured_rate_hz(measured.get(r.message, []), final_window_s))
             for r in plan.rates
         )
-        final_hz = steps[-1].measured_hz
-        reached = abs(final_hz - steps[-1].requested_hz) <= tolerance * steps[-1].requested_hz
-        util = plan.utilisation_pct
-        budget = (
-            "unlimited link"
-            if util is None
-            else f"{util:.0f} % of {plan.capacity_bytes_per_s:.0f} B/s"
-        )
+        last = steps[-1]
+        final_hz = last.measured_hz
+        reached = abs(final_hz - target_rate_hz) <= tolerance * target_rate_hz
+        confirmed = abs(final_hz - last.requested_hz) <= tolerance * last.requested_hz
+        limited = limit_hz < target_rate_hz
+        if capacity is None:
+            carried = f"{last.rx_bytes_per_s:.0f} B/s carried (network link)"
+        else:
+            carried = (
+                f"{last.rx_bytes_per_s:.0f} B/s carried of {capacity:.0f} B/s "
+                f"({100.0 * last.rx_bytes_per_s / capacity:.0f} %)"
+            )
         self._event(
             self._clock(),
             LinkEventKind.STREAMS,
-            f"ATTITUDE {final_hz:.1f} Hz of {steps[-1].requested_hz:.1f} Hz asked; "
-            f"{plan.total_bytes_per_s:.0f} B/s planned ({budget})",
+            f"ATTITUDE {final_hz:.1f} Hz of {last.requested_hz:.1f} Hz asked; {carried}"
+            + (f"; link budget limits fast streams to {limit_hz:.1f} Hz" if limited else ""),
         )
         return BringUpReport(
             dialect=self._dialect,
@@ -771,6 +802,8 @@ class VehicleLink:
             achieved_hz=achieved,
             target_rate_hz=target_rate_hz,
             reached=reached,
+            confirmed=confirmed,
+            limit_hz=limit_hz if limited else None,
         )
 
     # ------------------------------------------------------------------ closing

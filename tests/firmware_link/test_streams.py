@@ -7,7 +7,12 @@ import pytest
 from firmware_link import DataStream, LinkError, StreamWanted, plan_streams, wanted_streams
 from firmware_link.protocol import WireVersion, frame_overhead_bytes, payload_bytes
 from firmware_link.records import Dialect
-from firmware_link.streams import bring_up_periods_ms, measured_rate_hz, step_plan
+from firmware_link.streams import (
+    bring_up_periods_ms,
+    fast_rate_limit_hz,
+    measured_rate_hz,
+    step_plan,
+)
 
 SERIAL_115200 = 11520.0
 
@@ -102,3 +107,13 @@ def test_measured_rate_uses_intervals_over_their_span() -> None:
     stamps = [0.1 + k * 0.025 for k in range(41)]
     assert measured_rate_hz(stamps, 1.0) == pytest.approx(40.0)
     assert measured_rate_hz([], 1.0) == 0.0
+
+
+def test_measured_budget_limits_the_fast_rate_to_what_fits() -> None:
+    # At 25 Hz the link carried 10,000 B/s of which 7,500 B/s ran at the step rate (300 B per
+    # cycle); the other 2,500 B/s stay. A 9,216 B/s budget then allows (9216 - 2500) / 300 Hz.
+    assert fast_rate_limit_hz(10_000.0, 7_500.0, 25.0, 9_216.0) == pytest.approx(22.387, 1e-3)
+    assert fast_rate_limit_hz(1_000.0, 0.0, 25.0, 9_216.0) == float("inf")
+    plan = plan_streams(None, wanted_streams(Dialect.APM25), wire=WireVersion.V1, grouped=True)
+    limited = step_plan(plan, 25.0, whole_hz=True, limit_hz=33.7)
+    assert limited["ATTITUDE"] == 33.0 and limited["VFR_HUD"] == 10.0
