@@ -9,6 +9,7 @@ The mean's spatial gradient (the ``∇I`` of eqs. 10.5–10.7) is analytic.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -35,11 +36,6 @@ def se_kernel(a: np.ndarray, b: np.ndarray, hyper: GpHyper) -> np.ndarray:
     scale = np.array([hyper.lengthscale_x_m, hyper.lengthscale_y_m])
     da = a[:, None, :] / scale - b[None, :, :] / scale
     return hyper.signal_std**2 * np.exp(-0.5 * np.sum(da * da, axis=-1))
-
-
-def _chol_solve(chol: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Solve (L L^T) x = rhs with the lower factor L."""
-    return np.linalg.solve(chol.T, np.linalg.solve(chol, rhs))
 
 
 def _cholesky(k: np.ndarray) -> np.ndarray:
@@ -83,10 +79,44 @@ class GaussianProcess:
         nv = np.broadcast_to(np.asarray(noise_var, dtype=float), y.shape).copy()
         k = se_kernel(x, x, hyper) + np.diag(nv)
         chol = _cholesky(k)
-        alpha = _chol_solve(chol, y - prior_mean)
-        # One triangular solve per fit; every prediction is then a product, not a solve.
+        # One triangular solve per fit; alpha and every prediction are then products.
         chol_inv = np.linalg.solve(chol, np.eye(chol.shape[0]))
+        alpha = chol_inv.T @ (chol_inv @ (y - prior_mean))
         return cls(hyper, x, y, nv, float(prior_mean), chol, alpha, chol_inv)
+
+    def extended(
+        self, x_new: np.ndarray, y_new: np.ndarray, noise_new: np.ndarray, prior_mean: float
+    ) -> GaussianProcess:
+        """The same GP conditioned on more samples, by appending rows to the Cholesky factor.
+
+        Each new point costs matrix-vector products only (no refactorisation), which keeps an
+        online mapper cheap; the result equals :meth:`fit` on all samples up to rounding.
+        """
+        x_new = np.asarray(x_new, dtype=float).reshape(-1, 2)
+        y_new = np.asarray(y_new, dtype=float).reshape(-1)
+        noise_new = np.broadcast_to(np.asarray(noise_new, dtype=float), y_new.shape)
+        x, chol, chol_inv = self.x_train, self._chol, self._chol_inv
+        for p, nv in zip(x_new, noise_new, strict=True):
+            k_vec = se_kernel(p[None, :], x, self.hyper)[0]
+            row = chol_inv @ k_vec
+            d_sq = self.hyper.signal_std**2 + nv + _JITTER - float(row @ row)
+            d = math.sqrt(max(d_sq, _JITTER))
+            n = chol.shape[0]
+            chol = np.block([[chol, np.zeros((n, 1))], [row[None, :], np.array([[d]])]])
+            inv_row = -(row @ chol_inv) / d
+            chol_inv = np.block(
+                [[chol_inv, np.zeros((n, 1))], [inv_row[None, :], np.array([[1 / d]])]]
+            )
+            x = np.vstack([x, p[None, :]])
+        y = np.concatenate([self.y_train, y_new])
+        nv_all = np.concatenate([self.noise_var, noise_new])
+        alpha = chol_inv.T @ (chol_inv @ (y - prior_mean))
+        return GaussianProcess(self.hyper, x, y, nv_all, float(prior_mean), chol, alpha, chol_inv)
+
+    def predict_mean(self, xq: np.ndarray) -> np.ndarray:
+        """Posterior mean only (eq. 10.15), cheaper than :meth:`predict`."""
+        xq = np.asarray(xq, dtype=float).reshape(-1, 2)
+        return self.prior_mean + se_kernel(xq, self.x_train, self.hyper) @ self._alpha
 
     def predict(self, xq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Posterior mean (eq. 10.15) and latent variance (eq. 10.16) at points xq (m, 2)."""
@@ -130,6 +160,28 @@ class GaussianProcess:
         )
 
 
+def _forward_substitution(chol: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Solve L z = b for lower-triangular L, one row at a time (no LU factorisation)."""
+    z = np.zeros_like(b)
+    for i in range(b.shape[0]):
+        z[i] = (b[i] - chol[i, :i] @ z[:i]) / chol[i, i]
+    return z
+
+
+def log_marginal_likelihood(
+    x: np.ndarray, y: np.ndarray, hyper: GpHyper, noise_var: np.ndarray | float, prior_mean: float
+) -> float:
+    """log p(y | x, hyper) from one Cholesky factor, without conditioning a full GP."""
+    x = np.asarray(x, dtype=float).reshape(-1, 2)
+    resid = np.asarray(y, dtype=float).reshape(-1) - prior_mean
+    nv = np.broadcast_to(np.asarray(noise_var, dtype=float), resid.shape)
+    chol = _cholesky(se_kernel(x, x, hyper) + np.diag(nv))
+    z = _forward_substitution(chol, resid)
+    return float(
+        -0.5 * z @ z - np.sum(np.log(np.diag(chol))) - 0.5 * resid.shape[0] * np.log(2.0 * np.pi)
+    )
+
+
 def fit_by_grid_search(
     x: np.ndarray,
     y: np.ndarray,
@@ -145,14 +197,10 @@ def fit_by_grid_search(
     y = np.asarray(y, dtype=float)
     spread = float(np.sqrt(np.mean((y - prior_mean) ** 2))) if y.size > 1 else base.signal_std
     signal_std = max(spread, 1e-3)
-    best: GaussianProcess | None = None
-    best_lml = -np.inf
-    for lx in lengthscales_m:
-        for ly in lengthscales_m:
-            hyper = replace(base, signal_std=signal_std, lengthscale_x_m=lx, lengthscale_y_m=ly)
-            gp = GaussianProcess.fit(x, y, hyper, noise_var, prior_mean)
-            lml = gp.log_marginal_likelihood()
-            if lml > best_lml:
-                best, best_lml = gp, lml
-    assert best is not None
-    return best
+    candidates = [
+        replace(base, signal_std=signal_std, lengthscale_x_m=lx, lengthscale_y_m=ly)
+        for lx in lengthscales_m
+        for ly in lengthscales_m
+    ]
+    best = max(candidates, key=lambda h: log_marginal_likelihood(x, y, h, noise_var, prior_mean))
+    return GaussianProcess.fit(x, y, best, noise_var, prior_mean)

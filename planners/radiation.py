@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Generator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 
 import numpy as np
@@ -117,9 +117,9 @@ class RadiationMapperParams:
     stability_weight: float = 0.3  # W_c of eq. 10.22
     max_trace_steps: int = 40
     map_resolution_m: float = 0.1
-    gp_lengthscales_m: tuple[float, ...] = (0.75, 1.0, 1.5, 2.0, 3.0)
+    gp_lengthscales_m: tuple[float, ...] = (1.0, 1.5, 2.0, 3.0)
     gp_nugget: float = 0.002  # log-space model error on top of Poisson noise
-    gp_refit_every: int = 12
+    gp_refit_every: int = 20
 
     def __post_init__(self) -> None:
         """Reject parameter sets the mapper cannot fly."""
@@ -277,7 +277,7 @@ class RadiationMapper:
         self._rejected: list[np.ndarray] = []
         self._layers: tuple[Layer, ...] = ()
         self._level: float | None = None
-        self._hyper: GpHyper | None = None
+        self._gp: GaussianProcess | None = None
         self._hyper_n = 0
         self._start_cps = 1.0
         self._rejected_readings = 0
@@ -347,9 +347,10 @@ class RadiationMapper:
             or not (math.isfinite(counts_per_s) and counts_per_s >= 0.0)
         ):
             # A garbled reading is dropped and counted; the same target is asked for again.
-            self._rejected_readings += 1
             if self._last is None:
                 raise ValueError("the first reading must be a finite position and counts >= 0")
+            self._rejected_readings += 1
+            self._last = replace(self._last, rejected_readings=self._rejected_readings)
             return self._last
         try:
             if self._gen is None:
@@ -538,18 +539,25 @@ class RadiationMapper:
         self._cps.append(float(cps))
 
     def _fit(self, search: bool = False) -> GaussianProcess:
-        """GP on log-intensity; hyperparameters re-searched every ``gp_refit_every`` samples."""
+        """GP on log-intensity; hyperparameters re-searched every ``gp_refit_every`` samples.
+
+        Between searches the previous fit is extended with the new samples (rank-one Cholesky
+        updates), so a step costs matrix-vector products instead of a factorisation.
+        """
         p = self.params
         x = np.array(self._pos)
         counts = np.maximum(np.array(self._cps) * p.dwell_s, 0.5)
         y = np.log(counts / p.dwell_s)
         noise = 1.0 / counts + p.gp_nugget
         prior = float(np.quantile(y, 0.2))
-        if search or self._hyper is None or len(y) - self._hyper_n >= p.gp_refit_every:
-            gp = fit_by_grid_search(x, y, GpHyper(), p.gp_lengthscales_m, noise, prior)
-            self._hyper, self._hyper_n = gp.hyper, len(y)
-            return gp
-        return GaussianProcess.fit(x, y, self._hyper, noise, prior)
+        n = len(y)
+        if search or self._gp is None or n - self._hyper_n >= p.gp_refit_every:
+            self._gp = fit_by_grid_search(x, y, GpHyper(), p.gp_lengthscales_m, noise, prior)
+            self._hyper_n = n
+        else:
+            m = self._gp.x_train.shape[0]
+            self._gp = self._gp.extended(x[m:], y[m:], noise[m:], prior)
+        return self._gp
 
     def _background_cps(self) -> float:
         """Background estimate: a low quantile of the readings."""
@@ -561,7 +569,7 @@ class RadiationMapper:
         r = p.max_sample_distance_m
         g = np.linspace(-r, r, 31)
         pts = np.array([p.clip(center + np.array([dx, dy])) for dx in g for dy in g])
-        mean, _ = self._fit().predict(pts)
+        mean = self._fit().predict_mean(pts)
         k = int(np.argmax(mean))
         return Hotspot((float(pts[k, 0]), float(pts[k, 1])), float(math.exp(mean[k])))
 
@@ -618,7 +626,7 @@ class RadiationMapper:
         p = self.params
         r = np.arange(0.05, 2.0 * p.max_sample_distance_m, 0.05)
         pts = centre[None, :] + r[:, None] * direction[None, :]
-        mean, _ = gp.predict(pts)
+        mean = gp.predict_mean(pts)
         below = np.nonzero(mean < log_level)[0]
         return float(r[below[0]]) if below.size else float(r[-1])
 
@@ -629,23 +637,26 @@ class RadiationMapper:
             return float(max(self._cps)) * p.layer_ratio
         peak = min(h.peak_cps for h in self._hotspots)
         bg = self._background_cps()
+        levels = [
+            peak * p.layer_ratio**k
+            for k in range(1, p.n_layers + 1)
+            if peak * p.layer_ratio**k > 1.5 * bg
+        ] or [peak * p.layer_ratio]
+        # Radial profiles of the model along 16 rays from every hotspot, in one prediction.
         angles = np.linspace(0.0, 2.0 * math.pi, 16, endpoint=False)
         dirs = np.column_stack([np.cos(angles), np.sin(angles)])
+        radii = np.arange(0.05, 2.0 * p.max_sample_distance_m, 0.05)
+        centres = np.array([h.pos_n for h in self._hotspots])
+        pts = centres[:, None, None, :] + radii[None, None, :, None] * dirs[None, :, None, :]
+        mean = gp.predict_mean(pts.reshape(-1, 2)).reshape(pts.shape[:3])
         layers: list[Layer] = []
-        for k in range(1, p.n_layers + 1):
-            level = peak * p.layer_ratio**k
-            if level <= 1.5 * bg:
-                break
-            grads: list[float] = []
-            for h in self._hotspots:
-                c = np.array(h.pos_n)
-                for d in dirs:
-                    r = self._crossing_radius(gp, c, d, math.log(level))
-                    if r < 2.0 * p.max_sample_distance_m - 0.05:
-                        grads.append(float(np.linalg.norm(gp.gradient(c + r * d)[0])))
-            layers.append(Layer(level, float(np.mean(grads)) if grads else 0.0))
-        if not layers:
-            layers.append(Layer(peak * p.layer_ratio, 0.0))
+        for level in levels:
+            below = mean < math.log(level)
+            crossed = below.any(axis=2)
+            first = np.argmax(below, axis=2)
+            where = pts[crossed, first[crossed]] if crossed.any() else np.zeros((0, 2))
+            grads = np.linalg.norm(gp.gradient(where), axis=1) if where.size else np.zeros(0)
+            layers.append(Layer(level, float(np.mean(grads)) if grads.size else 0.0))
         self._layers = tuple(layers)
         return max(layers, key=lambda lay: lay.log_gradient_per_m).level_cps
 

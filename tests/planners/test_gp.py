@@ -3,7 +3,13 @@
 import numpy as np
 import pytest
 
-from planners.gp import GaussianProcess, GpHyper, fit_by_grid_search, se_kernel
+from planners.gp import (
+    GaussianProcess,
+    GpHyper,
+    fit_by_grid_search,
+    log_marginal_likelihood,
+    se_kernel,
+)
 
 
 def smooth(p: np.ndarray) -> np.ndarray:
@@ -90,3 +96,28 @@ def test_rejects_bad_shapes_and_hyperparameters() -> None:
         GaussianProcess.fit(np.zeros((3, 2)), np.zeros(2), GpHyper())
     with pytest.raises(ValueError):
         GpHyper(1.0, 0.0, 1.0)
+
+
+def test_extending_a_fit_equals_refitting_on_all_samples() -> None:
+    rng = np.random.default_rng(8)
+    x = rng.uniform(0.0, 6.0, size=(30, 2))
+    y = smooth(x)
+    noise = rng.uniform(0.001, 0.05, size=30)
+    hyper = GpHyper(0.9, 1.3, 2.1)
+    grown = GaussianProcess.fit(x[:10], y[:10], hyper, noise[:10], 0.1)
+    grown = grown.extended(x[10:], y[10:], noise[10:], prior_mean=-0.2)
+    full = GaussianProcess.fit(x, y, hyper, noise, -0.2)
+    q = rng.uniform(0.0, 6.0, size=(50, 2))
+    for a, b in zip(grown.predict(q), full.predict(q), strict=True):
+        np.testing.assert_allclose(a, b, atol=1e-8)
+    assert grown.log_marginal_likelihood() == pytest.approx(full.log_marginal_likelihood())
+
+
+def test_standalone_marginal_likelihood_matches_the_conditioned_gp() -> None:
+    x = lattice(5, 0.0, 4.0)
+    y = smooth(x)
+    hyper = GpHyper(0.8, 1.0, 1.7)
+    gp = GaussianProcess.fit(x, y, hyper, 0.01, 0.2)
+    assert log_marginal_likelihood(x, y, hyper, 0.01, 0.2) == pytest.approx(
+        gp.log_marginal_likelihood()
+    )

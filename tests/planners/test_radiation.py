@@ -1,0 +1,154 @@
+"""The Chapter 10 mapper: step API, phases, and whole runs on analytic floors."""
+
+import math
+
+import numpy as np
+import pytest
+
+from planners.lawnmower import lawnmower_path, run_lawnmower
+from planners.radiation import (
+    Phase,
+    RadiationMapper,
+    RadiationMapperParams,
+    Status,
+    fan_points,
+    run_radiation,
+    sampling_distance_m,
+)
+from planners.radiation_field import RadiationField
+
+# worlds/radiation_3src.toml: a 20 x 20 m floor, three equal sources, background 1 %.
+THREE = RadiationField.from_tuples(
+    [(-5.0, -4.0, 5000.0), (4.0, -5.0, 5000.0), (1.0, 6.0, 5000.0)], 50.0
+)
+ONE = RadiationField.from_tuples([(3.0, 2.0, 4000.0)], 40.0)
+
+
+@pytest.fixture(scope="module")
+def three_source_run():
+    """One seeded planner run on the thesis's three-source floor."""
+    return run_radiation(THREE, RadiationMapperParams(), np.random.default_rng(2026), 400)
+
+
+def test_three_source_floor_encloses_every_source(three_source_run) -> None:
+    r = three_source_run
+    assert r.status is Status.REACHED, r.reason
+    assert r.sources_enclosed == r.sources_total == 3
+    assert r.iou >= 0.85
+    assert len(r.contour_polygons) == 3  # three separate hotspot regions
+    assert len(r.hotspots) == 3
+
+
+def test_three_source_run_samples_far_less_than_a_survey(three_source_run) -> None:
+    r = three_source_run
+    survey_1m = lawnmower_path(1.0, RadiationMapperParams()).shape[0]
+    assert r.n_samples < 0.5 * survey_1m
+    assert r.explored_fraction < 0.3
+    assert r.path_length_m == pytest.approx(
+        float(np.sum(np.linalg.norm(np.diff(r.path_n, axis=0), axis=1)))
+    )
+
+
+def test_level_is_a_layer_under_every_hotspot(three_source_run) -> None:
+    r = three_source_run
+    peaks = [h.peak_cps for h in r.hotspots]
+    assert 50.0 < r.level_cps < min(peaks)
+    chosen = max(r.layers, key=lambda lay: lay.log_gradient_per_m)
+    assert chosen.level_cps == pytest.approx(r.level_cps)
+    # Each hotspot found within half a metre of a true source.
+    for h in r.hotspots:
+        d = np.min(np.linalg.norm(THREE.source_xy_m - np.array(h.pos_n), axis=1))
+        assert d < 0.5
+
+
+def test_maps_are_on_the_floor_grid(three_source_run) -> None:
+    r = three_source_run
+    assert r.mean_cps.shape == (r.map_ys_m.size, r.map_xs_m.size) == r.log_var.shape
+    assert np.all(r.log_var >= 0.0)
+    assert r.map_xs_m[0] == -10.0 and r.map_xs_m[-1] == 10.0
+    assert r.samples.shape == (r.n_samples, 3)
+
+
+def test_phases_run_in_order_and_decisions_stay_on_the_floor() -> None:
+    rng = np.random.default_rng(4)
+    mapper = RadiationMapper(max_samples=300)
+    pos = np.array([-9.0, -9.0])
+    phases: list[Phase] = []
+    while True:
+        d = mapper.step(pos, ONE.sample(pos, rng, 1.0))
+        if not phases or phases[-1] is not d.phase:
+            phases.append(d.phase)
+        if d.done:
+            break
+        assert -10.0 <= d.next_pos_n[0] <= 10.0 and -10.0 <= d.next_pos_n[1] <= 10.0
+        pos = np.array(d.next_pos_n)
+    assert phases[0] is Phase.LEARNING
+    assert phases[-2:] == [Phase.EXECUTING, Phase.DONE]
+    assert mapper.status is Status.REACHED
+    assert len(mapper.hotspots) == 1
+    est = mapper.map_estimate()
+    assert est.region.covers(__import__("shapely").Point(3.0, 2.0))
+    # After done, further readings change nothing.
+    again = mapper.step(pos, 1.0)
+    assert again.done and again.samples == d.samples
+
+
+def test_garbled_readings_are_dropped_and_counted() -> None:
+    mapper = RadiationMapper()
+    first = mapper.step((-9.0, -9.0), 40.0)
+    again = mapper.step((float("nan"), 0.0), 40.0)
+    assert again.next_pos_n == first.next_pos_n and again.rejected_readings == 1
+    again = mapper.step(first.next_pos_n, -5.0)
+    assert again.rejected_readings == 2 and again.samples == 1
+    with pytest.raises(ValueError, match="first reading"):
+        RadiationMapper().step((0.0, 0.0), float("inf"))
+
+
+def test_spent_budget_fails_with_a_reason_and_a_real_partial_map() -> None:
+    r = run_radiation(ONE, None, np.random.default_rng(1), max_samples=12)
+    assert r.status is Status.FAILED
+    assert "budget" in r.reason
+    assert r.n_samples == 12
+
+
+def test_fan_is_spread_over_the_field_of_view() -> None:
+    p = RadiationMapperParams()
+    fan = fan_points(np.array([0.0, 0.0]), 0.0, 2.0, p)
+    np.testing.assert_allclose(np.linalg.norm(fan, axis=1), 2.0)
+    angles = np.degrees(np.arctan2(fan[:, 1], fan[:, 0]))
+    np.testing.assert_allclose(angles, [-72.0, -36.0, 0.0, 36.0, 72.0])
+    clipped = fan_points(np.array([9.5, 0.0]), 0.0, 2.0, p)
+    assert np.all(clipped[:, 0] <= 10.0)
+
+
+def test_sampling_distance_shrinks_as_intensity_grows() -> None:
+    p = RadiationMapperParams()
+    d = [sampling_distance_m(i, 50.0, p) for i in (50.0, 200.0, 800.0, 1e6)]
+    assert d[0] == pytest.approx(p.k1_gain_m)
+    assert d[1] == pytest.approx(p.k1_gain_m / 2.0)
+    assert d[0] > d[1] > d[2] >= d[3] == p.min_sample_distance_m
+
+
+def test_lawnmower_is_a_boustrophedon_and_converges_with_spacing() -> None:
+    p = RadiationMapperParams()
+    path = lawnmower_path(2.0, p)
+    assert path.shape == (121, 2)
+    steps = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    np.testing.assert_allclose(steps, 2.0)  # no diagonal jumps between rows
+    level = 0.4 * ONE.intensity_at((3.0, 2.0))
+    coarse = run_lawnmower(ONE, 2.0, level, np.random.default_rng(0))
+    fine = run_lawnmower(ONE, 0.5, level, np.random.default_rng(0))
+    assert fine.iou > coarse.iou and fine.iou > 0.9
+    assert fine.sources_enclosed == 1 and fine.explored_fraction == 1.0
+    with pytest.raises(ValueError):
+        run_lawnmower(ONE, 0.0, level, np.random.default_rng(0))
+
+
+def test_bad_parameters_are_rejected() -> None:
+    with pytest.raises(ValueError):
+        RadiationMapperParams(x_min_m=5.0, x_max_m=5.0)
+    with pytest.raises(ValueError):
+        RadiationMapperParams(layer_ratio=1.5)
+    with pytest.raises(ValueError):
+        RadiationMapper(max_samples=0)
+    assert math.isclose(RadiationMapperParams().floor_area_m2, 400.0)
