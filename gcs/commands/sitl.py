@@ -7,6 +7,7 @@ flags, so its stdout contract and exit codes are exactly the SITL's own.
 from __future__ import annotations
 
 import argparse
+import signal
 import subprocess
 import sys
 from typing import Any
@@ -58,10 +59,15 @@ def sitl_argv(args: argparse.Namespace) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the SITL in the foreground; its exit code is ours."""
+    """Run the SITL in the foreground; SIGINT/SIGTERM are passed on; its exit code is ours."""
     proc = subprocess.Popen(sitl_argv(args))
+
+    def forward(sig: int, _frame: object) -> None:
+        proc.send_signal(sig)
+
+    previous = {s: signal.signal(s, forward) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
         return proc.wait()
-    except KeyboardInterrupt:
-        proc.terminate()
-        return proc.wait()
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
