@@ -10,7 +10,18 @@ from planners.formation import Formation, FormationParams, Role
 from planners.geometry import Box, Vec3, World
 from planners.grid import Grid, GridParams
 from planners.kinematic import KinematicParams, KinematicSim, MoveOutcome
+from planners.lawnmower import run_lawnmower
 from planners.proximity import Facing, ProximityParams, ProximityReading, sense
+from planners.radiation import Decision as RadiationDecision
+from planners.radiation import Phase as RadiationPhase
+from planners.radiation import (
+    RadiationMapper,
+    RadiationMapperParams,
+    RadiationResult,
+    run_radiation,
+)
+from planners.radiation import Status as RadiationStatus
+from planners.radiation_field import RadiationField
 from planners.result import PlanResult, PlanStatus
 
 __all__ = [
@@ -39,6 +50,13 @@ __all__ = [
     "PlanStatus",
     "ProximityParams",
     "ProximityReading",
+    "RadiationDecision",
+    "RadiationField",
+    "RadiationMapper",
+    "RadiationMapperParams",
+    "RadiationPhase",
+    "RadiationResult",
+    "RadiationStatus",
     "Role",
     "Vec3",
     "World",
@@ -47,5 +65,7 @@ __all__ = [
     "run_dstar_lite",
     "run_epbha",
     "run_flock",
+    "run_lawnmower",
+    "run_radiation",
     "sense",
 ]
