@@ -588,6 +588,9 @@ def run_epbha(
 ) -> PlanResult:
     """Fly EPBHA in the kinematic world from `start_n` toward `goal_n`."""
     params = params or EpbhaParams()
+    if world.clearance(start_n) == 0.0:
+        return PlanResult("EPBHA", PlanStatus.START_BLOCKED, (tuple(start_n),), 0, 0, (), 0.0,
+                          0, "start is inside an obstacle or outside the room")
     proximity = proximity or ProximityParams(range_m=params.sensor_range_m)
     sim = KinematicSim(world, start_n, kinematic or KinematicParams(), proximity, rng)
     planner = Epbha(params, goal_n, start_n)

@@ -231,3 +231,10 @@ def test_noisy_sensors_still_reach_the_thesis_scenes() -> None:
                       proximity=ProximityParams(noise_sigma_m=0.01),
                       rng=np.random.default_rng(7))
         assert r.reached and r.collisions == 0, scene.name
+
+
+def test_run_epbha_refuses_a_start_inside_an_obstacle() -> None:
+    scene = thesis_scenes()[0]
+    inside_table = (3.5, 2.0, -0.78)
+    r = run_epbha(scene.world, inside_table, scene.goal_n)
+    assert r.status is PlanStatus.START_BLOCKED and len(r.path) == 1
