@@ -102,6 +102,8 @@ class FlockParams:
     sidestep_overshoot_steps: int = 2
     cost_weights: Vec3 = (4.0, 2.0, 6.0)  # Definition 7's A, B (even), and one for altitude
     common_wait_steps: int = 150  # how long the root waits at the common goal for its team
+    overfly_after_steps: int = 4  # blocked this long by teammates, a vehicle flies over them
+    overfly_height_m: float = 0.7  # above its goal altitude; more than the safe distance
     policy: FollowerPolicy = FollowerPolicy.HEADS_UP
     latency_steps: int = 0
     formation: FormationParams = field(default_factory=FormationParams)
@@ -113,6 +115,8 @@ class FlockParams:
             raise ValueError(f"boost must be >= 1, got {self.boost}")
         if self.n_layers < 1 or self.layer_spacing_m < 0.0:
             raise ValueError("n_layers must be >= 1 and layer_spacing_m >= 0")
+        if self.overfly_height_m < self.formation.safe_distance_m:
+            raise ValueError("overfly_height_m must be at least the safe distance")
 
 
 @dataclass(frozen=True, slots=True)
@@ -155,6 +159,8 @@ class _State:
     individual: bool = False  # flying its individual goal (Algorithm 9.3.4)
     arrived_final: bool = False
     make_way_from: list[Vec3] = field(default_factory=list)  # where higher-priority ones wanted
+    guard_blocked: int = 0  # consecutive steps the guard refused this vehicle's best move
+    overfly: bool = False  # climbing over teammates that block the way to its goal
 
 
 def _add(p: Vec3, d: Vec3, s: float) -> Vec3:
@@ -193,6 +199,7 @@ class FlockPlanner:
         self._wait_at_common = 0
         self._states = [_State() for _ in range(self.n)]
         self._wanted: dict[int, Vec3] = {}  # guard-refused moves this step, by tree index
+        self._start_pos: list[Vec3] = []
         g = mission.common_goal_n
         self._final_n: list[Vec3] = []
         for k in range(self.n):
@@ -243,6 +250,7 @@ class FlockPlanner:
             self._remember_returns(k, pos[k], rd[k])  # type: ignore[arg-type]
         reserved: list[Vec3] = list(pos)  # type: ignore[arg-type]
         self._wanted = {}
+        self._start_pos = list(reserved)
         modes: dict[int, VehicleMode] = {}
         held: list[int] = []
         sent = 0
@@ -275,6 +283,7 @@ class FlockPlanner:
                 sp = self._make_way(k, p, sp, rd[k], reserved)
             reserved[k] = sp
             modes[self.ids[k]] = mode
+            self._note_blocking(k, mode)
             if not self._states[k].individual:
                 sent += self.channel.offer(
                     step_index, k, self.formation.children(k), sp, avoiding
@@ -313,8 +322,48 @@ class FlockPlanner:
         return r is None or r > s + self.params.stop_distance_m
 
     def _guard_ok(self, k: int, sp: Vec3, reserved: list[Vec3]) -> bool:
+        """k's move to ``sp`` keeps the safe distance from every teammate all along the step.
+
+        Teammates planned earlier this step move from their start to their granted set
+        position; the others stay put. Both moves are straight and take the same step, so the
+        closest approach is checked exactly, not only at the ends.
+        """
         safe = self.params.formation.safe_distance_m
-        return all(j == k or _dist(sp, q) >= safe for j, q in enumerate(reserved))
+        p0 = self._start_pos[k]
+        for j, q1 in enumerate(reserved):
+            if j == k:
+                continue
+            q0 = self._start_pos[j]
+            d0 = (p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2])
+            dv = (
+                sp[0] - p0[0] - (q1[0] - q0[0]),
+                sp[1] - p0[1] - (q1[1] - q0[1]),
+                sp[2] - p0[2] - (q1[2] - q0[2]),
+            )
+            vv = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]
+            dot = d0[0] * dv[0] + d0[1] * dv[1] + d0[2] * dv[2]
+            t = 1.0 if vv < 1e-15 else min(1.0, max(0.0, -dot / vv))
+            if math.hypot(d0[0] + t * dv[0], d0[1] + t * dv[1], d0[2] + t * dv[2]) < safe:
+                return False
+        return True
+
+    def _note_blocking(self, k: int, mode: VehicleMode) -> None:
+        """Count steps the guard refused k's best move; long enough, k flies over the jam."""
+        st = self._states[k]
+        st.guard_blocked = st.guard_blocked + 1 if k in self._wanted else 0
+        free_to_climb = mode in (VehicleMode.FORMATION, VehicleMode.INDIVIDUAL)
+        if st.guard_blocked >= self.params.overfly_after_steps and free_to_climb:
+            st.overfly = True
+
+    def _overfly_target(self, k: int, p: Vec3, goal: Vec3) -> Vec3:
+        """The goal, or a point right above it while k is flying over teammates."""
+        st = self._states[k]
+        above = math.hypot(goal[0] - p[0], goal[1] - p[1]) <= self.params.goal_tolerance_m
+        if st.overfly and above:
+            st.overfly = False
+        if not st.overfly:
+            return goal
+        return (goal[0], goal[1], goal[2] - self.params.overfly_height_m)
 
     def _ask_to_make_way(self, k: int, wanted: Vec3, reserved: list[Vec3]) -> None:
         """Vehicles of lower priority in the way of k's wanted move will step aside next step."""
@@ -489,17 +538,19 @@ class FlockPlanner:
             return p, VehicleMode.WAITING
         if st.in_trail:
             return self._walk_trail(k, p, reading, reserved)
-        dist = _dist(p, st.goal_n)
+        goal = self._overfly_target(k, p, st.goal_n)
+        dist = _dist(p, goal)
         if dist <= prm.goal_tolerance_m and st.avoid_dir is None:
             return p, VehicleMode.WAITING
         s_max = prm.step_m * (prm.boost if dist > prm.catchup_distance_m else 1.0)
         if prm.policy is FollowerPolicy.HEADS_UP and st.avoid_dir is None:
-            sp, primary_free = self._greedy(p, st.goal_n, s_max, reading, k, reserved)
+            sp, primary_free = self._greedy(p, goal, s_max, reading, k, reserved)
             if not primary_free and st.trail:
+                st.overfly = False
                 self._enter_trail(k, p)
                 return self._walk_trail(k, p, reading, reserved)
             return (sp if sp is not None else p), VehicleMode.FORMATION
-        sp, avoiding = self._seek(k, p, st.goal_n, s_max, reading, reserved)
+        sp, avoiding = self._seek(k, p, goal, s_max, reading, reserved)
         return sp, VehicleMode.AVOIDING if avoiding else VehicleMode.FORMATION
 
     def _enter_trail(self, k: int, p: Vec3) -> None:
@@ -525,14 +576,19 @@ class FlockPlanner:
             st.in_trail = False
             return self._follower(k, p, reading, reserved)
         dz = self._layer_offset_m(k) if st.trail_layer_on else 0.0
-        while True:
-            q = st.trail[min(st.trail_idx, len(st.trail) - 1)]
-            # Layers sit round the cruise altitude, not round a trail that may itself be layered.
-            z = self.mission.common_goal_n[2] + dz if st.trail_layer_on else q[2]
-            target = (q[0], q[1], z)
-            if _dist(p, target) > prm.step_m * 0.5 or st.trail_idx >= len(st.trail) - 1:
+        # Aim at the first trail point more than 1.5 d ahead (horizontally: the trail itself may
+        # be layered), so a vehicle nudged off the trail never turns back for a point behind it.
+        last = len(st.trail) - 1
+        st.trail_idx = min(st.trail_idx, last)
+        while st.trail_idx < last:
+            q = st.trail[st.trail_idx]
+            if math.hypot(q[0] - p[0], q[1] - p[1]) > 1.5 * prm.step_m:
                 break
             st.trail_idx += 1
+        q = st.trail[st.trail_idx]
+        # Layers sit round the cruise altitude, not round a trail that may itself be layered.
+        z = self.mission.common_goal_n[2] + dz if st.trail_layer_on else q[2]
+        target = (q[0], q[1], z)
         sp, primary_free = self._greedy(p, target, prm.step_m, reading, k, reserved)
         if not primary_free and st.trail_layer_on and dz != 0.0:
             st.trail_layer_on = False  # the trail is free at the leader's height, not above it
@@ -586,8 +642,12 @@ class FlockPlanner:
         self, k: int, p: Vec3, reading: ProximityReading, reserved: list[Vec3]
     ) -> tuple[Vec3, VehicleMode]:
         st = self._states[k]
-        target = self._final_n[k]
-        if _dist(p, target) <= self.params.goal_tolerance_m and st.avoid_dir is None:
+        target = self._overfly_target(k, p, self._final_n[k])
+        if (
+            _dist(p, target) <= self.params.goal_tolerance_m
+            and st.avoid_dir is None
+            and not st.overfly
+        ):
             st.arrived_final = True
             return p, VehicleMode.ARRIVED
         st.arrived_final = False
