@@ -15,7 +15,7 @@ import json
 import math
 import types
 import typing
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 VEC3_KEYS = ("x", "y", "z")
@@ -55,11 +55,7 @@ def to_jsonable(value: Any, hint: Any = None) -> Any:
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        hints = _hints(type(value))
-        return {
-            f.name: to_jsonable(getattr(value, f.name), hints.get(f.name))
-            for f in dataclasses.fields(value)
-        }
+        return _converter(type(value))(value)
     if isinstance(value, Mapping):
         return {str(k): to_jsonable(v) for k, v in value.items()}
     if isinstance(value, tuple | list):
@@ -73,6 +69,45 @@ def to_jsonable(value: Any, hint: Any = None) -> Any:
     if hasattr(value, "tolist"):  # numpy scalars and arrays
         return to_jsonable(value.tolist())
     return str(value)
+
+
+_PLAIN_TYPES = frozenset({int, float, str, bool, type(None)})
+_CONVERTERS: dict[type, Callable[[Any], dict[str, Any]]] = {}
+
+
+def _field_converter(hint: Any) -> Callable[[Any], Any]:
+    """A per-field converter: plain values pass straight through (NaN is nulled at encoding)."""
+    n = _fixed_float_tuple_len(hint)
+    if n:
+        keys = VEC3_KEYS if n == 3 else QUAT_KEYS
+
+        def vec(v: Any) -> Any:
+            if type(v) is tuple and len(v) == n:
+                return dict(zip(keys, v, strict=True))
+            return to_jsonable(v, hint)
+
+        return vec
+
+    def plain(v: Any) -> Any:
+        return v if type(v) in _PLAIN_TYPES else to_jsonable(v, hint)
+
+    return plain
+
+
+def _converter(cls: type) -> Callable[[Any], dict[str, Any]]:
+    """A dataclass → dict converter built once per class (the writer thread's hot path)."""
+    conv = _CONVERTERS.get(cls)
+    if conv is None:
+        hints = _hints(cls)
+        fields = tuple(
+            (f.name, _field_converter(hints.get(f.name))) for f in dataclasses.fields(cls)
+        )
+
+        def conv(obj: Any) -> dict[str, Any]:
+            return {name: c(getattr(obj, name)) for name, c in fields}
+
+        _CONVERTERS[cls] = conv
+    return conv
 
 
 def encode_json(message: Mapping[str, Any]) -> bytes:
