@@ -1,0 +1,262 @@
+"""Missions in the planners' kinematic world (the thesis's assumption of exact moves, §8.6).
+
+The same planners, the same six IR cones (with the mission's sensor noise) and the same goals
+as on a vehicle, but every set position is reached exactly, so a mission finishes in seconds.
+Mission time advances by one nominal step time per planner step (`NOMINAL_SPEED_MPS`), which is
+what `duration_s` reports; the recording is stamped on that timeline too.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from gcs.errors import UsageError
+from gcs.mission.planner_params import PlannerSetup
+from gcs.mission.radiation_maps import finish_radiation, is_reached
+from gcs.mission.recording import (
+    SAMPLE_RADIATION,
+    STEP_EPBHA,
+    STEP_FLOCK,
+    MissionRecording,
+    epbha_payload,
+    flock_payload,
+    radiation_payload,
+)
+from gcs.mission.report import MissionReport, MissionStatus, RunMode
+from gcs.mission.spec import MissionSpec
+from gcs.mission.world import MissionWorld
+from planners.epbha import Epbha, Status
+from planners.flock_scenes import FlockScene
+from planners.flock_sim import FlockRunParams, run_flock
+from planners.flocking import FlockMission, FlockPlanner, FlockStep
+from planners.geometry import Vec3
+from planners.kinematic import KinematicParams, KinematicSim
+from planners.proximity import ProximityParams, ProximityReading
+from planners.radiation import RadiationMapper
+
+NOMINAL_SPEED_MPS = 0.5  # a 0.1 m grid step every 0.2 s, as the flock runner assumes
+RADIATION_SPEED_MPS = 1.0
+
+Progress = Callable[[str], None]
+
+
+def start_of(spec: MissionSpec, mw: MissionWorld, index: int) -> Vec3:
+    """Where vehicle `index` of the mission starts on the floor (NED)."""
+    v = spec.vehicles[index]
+    if v.start_n is not None:
+        return v.start_n
+    starts = mw.start_positions_n
+    if index < len(starts):
+        return starts[index]
+    base = starts[-1]  # as the SITL places extra vehicles: a row 1 m apart to the east
+    return (base[0], base[1] + float(index - len(starts) + 1), base[2])
+
+
+def _at_altitude(p: Vec3, alt_m: float) -> Vec3:
+    return (p[0], p[1], -alt_m)
+
+
+def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                        rec: MissionRecording, progress: Progress | None) -> MissionReport:
+    """EPBHA from the take-off point to the goal with exact moves."""
+    wall0 = time.monotonic()
+    t0 = time.monotonic()
+    params = setup.params
+    goal = spec.goal_n
+    assert goal is not None
+    start = _at_altitude(start_of(spec, mw, 0), spec.takeoff_alt_m)
+    rng = np.random.default_rng(setup.seed)
+    prox = ProximityParams(range_m=params.sensor_range_m, cone_deg=params.sensor_cone_deg,
+                           noise_sigma_m=setup.noise_sigma_m)
+    sim = KinematicSim(mw.world, start, KinematicParams(), prox, rng)
+    planner = Epbha(params, goal, start)
+    dt = params.step_m / NOMINAL_SPEED_MPS
+    rec.scene(t0, mw.world.room, mw.world.obstacles)
+    status, reason = MissionStatus.FAILED, f"no goal after {setup.max_steps} steps"
+    obstacles: dict[str, int] = {}
+    k = 0
+    for k in range(setup.max_steps + 1):
+        t = t0 + k * dt
+        reading = sim.sense()
+        decision = planner.step(sim.pos_n, reading)
+        rec.put(STEP_EPBHA, t, epbha_payload(k, sim.pos_n, reading, decision,
+                                             planner.cost_evaluations))
+        rec.pose(t, sim.pos_n)
+        obstacles[decision.obstacle.value] = obstacles.get(decision.obstacle.value, 0) + 1
+        if progress is not None:
+            progress(_epbha_line(k, sim.pos_n, decision))
+        if decision.status is Status.REACHED:
+            status, reason = MissionStatus.REACHED, "goal reached"
+            break
+        if decision.status is Status.DEADLOCK:
+            reason = decision.reason.value
+            break
+        if k == setup.max_steps:
+            break
+        sim.move_to(decision.next_pos_n)
+    if status is MissionStatus.REACHED and math.dist(sim.pos_n, goal) > spec.goal_tolerance_m:
+        status = MissionStatus.FAILED
+        reason = (f"planner stopped {math.dist(sim.pos_n, goal):.2f} m from the goal "
+                  f"(tolerance {spec.goal_tolerance_m} m)")
+    path_len = sum(math.dist(a, b) for a, b in zip(sim.path, sim.path[1:], strict=False))
+    return MissionReport(
+        mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC, status=status,
+        reason=reason, collisions=sim.collisions, path_length_m=path_len,
+        duration_s=k * dt, wall_s=time.monotonic() - wall0, steps=len(sim.path) - 1,
+        recording=rec.path,
+        metrics={
+            "cost_evaluations": planner.cost_evaluations,
+            "min_clearance_m": sim.min_clearance_m,
+            "final_pos_n": list(sim.pos_n),
+            "goal_error_m": math.dist(sim.pos_n, goal),
+            "obstacle_steps": obstacles,
+        },
+    )
+
+
+def _epbha_line(k: int, pos: Vec3, d: Any) -> str:
+    return (f"step {k:4d} at ({pos[0]:+.2f}, {pos[1]:+.2f}, alt {-pos[2]:.2f}) "
+            f"{d.status.value:8s} {d.reason.value} [{d.obstacle.value}]")
+
+
+class _RecordedFlock:
+    """A FlockPlanner whose every step is recorded and reported (the runner drives it)."""
+
+    def __init__(self, inner: FlockPlanner, rec: MissionRecording, t0: float, dt_s: float,
+                 progress: Progress | None) -> None:
+        self.inner = inner
+        self.name = inner.name
+        self.rec = rec
+        self.t0 = t0
+        self.dt_s = dt_s
+        self.progress = progress
+
+    def step(self, step_index: int, positions_n: dict[int, Vec3],
+             readings: dict[int, ProximityReading]) -> FlockStep:
+        out = self.inner.step(step_index, positions_n, readings)
+        t = self.t0 + step_index * self.dt_s
+        self.rec.put(STEP_FLOCK, t, flock_payload(step_index, positions_n, readings, out))
+        for v, p in positions_n.items():
+            self.rec.pose(t, p, v)
+        if self.progress is not None and step_index % 10 == 0:
+            arrived = sum(self.inner.arrived().values())
+            err = out.formation_error_m
+            self.progress(f"step {step_index:4d} {out.phase.value:12s} arrived {arrived}/"
+                          f"{len(positions_n)} messages {out.messages_sent} formation error "
+                          + (f"{err:.2f} m" if err is not None else "-"))
+        return out
+
+    def final_targets_n(self) -> dict[int, Vec3]:
+        return self.inner.final_targets_n()
+
+    def start_positions_n(self, leader_start_n: Vec3) -> dict[int, Vec3]:
+        return self.inner.start_positions_n(leader_start_n)
+
+    def arrived(self) -> dict[int, bool]:
+        return self.inner.arrived()
+
+
+def flock_scene(spec: MissionSpec, mw: MissionWorld) -> FlockScene:
+    """The mission as a flock scene: the leader's start at take-off altitude, goals by index."""
+    goal = spec.goal_n
+    assert goal is not None
+    individual = dict(enumerate(spec.goals_n[1:]))
+    return FlockScene(spec.name, mw.world, _at_altitude(start_of(spec, mw, 0),
+                                                        spec.takeoff_alt_m), goal, individual)
+
+
+def run_flock_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                        rec: MissionRecording, progress: Progress | None) -> MissionReport:
+    """The triangular flock with exact moves; the runner keeps the safety books."""
+    wall0 = time.monotonic()
+    t0 = time.monotonic()
+    scene = flock_scene(spec, mw)
+    prm = FlockRunParams(dt_s=setup.params.step_m / NOMINAL_SPEED_MPS,
+                         proximity=ProximityParams(rings=1, noise_sigma_m=setup.noise_sigma_m))
+    rec.scene(t0, mw.world.room, mw.world.obstacles)
+
+    def factory(sc: FlockScene, ids: list[int]) -> _RecordedFlock:
+        goals = {ids[k]: g for k, g in sc.individual_goals_n.items() if k < len(ids)}
+        inner = FlockPlanner(ids, FlockMission(sc.common_goal_n, goals), sc.heading_n,
+                             setup.params)
+        return _RecordedFlock(inner, rec, t0, prm.dt_s, progress)
+
+    try:
+        res = run_flock(scene, len(spec.vehicles), factory, setup.max_steps,
+                        np.random.default_rng(setup.seed), prm)
+    except ValueError as exc:
+        raise UsageError(f"{spec.path}: {exc}") from None
+    lengths = {
+        v: float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))) if len(p) > 1 else 0.0
+        for v, p in res.paths_n.items()
+    }
+    reached = res.status.value == "reached" and res.collisions == 0
+    reason = res.reason if res.collisions == 0 else f"{res.reason}; {res.collisions} collisions"
+    return MissionReport(
+        mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC,
+        status=MissionStatus.REACHED if reached else MissionStatus.FAILED, reason=reason,
+        collisions=res.collisions, path_length_m=sum(lengths.values()),
+        duration_s=res.steps * res.dt_s, wall_s=time.monotonic() - wall0, steps=res.steps,
+        recording=rec.path,
+        metrics={
+            "vehicles": res.n_vehicles,
+            "min_separation_m": res.min_separation_m,
+            "min_clearance_m": res.min_clearance_m,
+            "messages_sent": res.messages_sent,
+            "formation_error_m": res.formation_error_m,
+            "time_to_goal_s": {str(v): res.time_to_goal_s(v) for v in res.steps_to_goal},
+            "path_length_per_vehicle_m": {str(v): x for v, x in lengths.items()},
+            "obstacle_collisions": res.obstacle_collisions,
+            "vehicle_collisions": res.vehicle_collisions,
+        },
+    )
+
+
+def run_radiation_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                            rec: MissionRecording, progress: Progress | None
+                            ) -> tuple[MissionReport, Any]:
+    """The contour mapper over the world's analytic field, perfect position hold."""
+    wall0 = time.monotonic()
+    t0 = time.monotonic()
+    p = setup.params
+    field = mw.radiation_field(height_m=spec.takeoff_alt_m)
+    rng = np.random.default_rng(setup.seed)
+    mapper = RadiationMapper(p, max_samples=setup.max_samples)
+    pos = p.clip(np.asarray(start_of(spec, mw, 0)[:2], dtype=float))
+    path = [pos]
+    t = 0.0
+    k = 0
+    rec.scene(t0, mw.world.room, mw.world.obstacles)
+    while True:
+        cps = field.sample(pos, rng, p.dwell_s)
+        t += p.dwell_s
+        decision = mapper.step(pos, cps)
+        rec.put(SAMPLE_RADIATION, t0 + t, radiation_payload(k, pos, cps, decision))
+        rec.pose(t0 + t, (float(pos[0]), float(pos[1]), -spec.takeoff_alt_m))
+        if progress is not None:
+            progress(f"sample {k:4d} at ({pos[0]:+6.2f}, {pos[1]:+6.2f}) {cps:8.1f} cps "
+                     f"{decision.phase.value:11s} {decision.reason}")
+        if decision.done:
+            break
+        nxt = np.asarray(decision.next_pos_n, dtype=float)
+        t += float(np.linalg.norm(nxt - pos)) / RADIATION_SPEED_MPS
+        pos = nxt
+        path.append(pos)
+        k += 1
+    path_xy = np.array(path)
+    metrics, products = finish_radiation(mapper, field, path_xy, rec, t0 + t)
+    ok, why = is_reached(metrics)
+    outside = sum(not mw.world.in_room((float(q[0]), float(q[1]), -spec.takeoff_alt_m))
+                  for q in path_xy)
+    report = MissionReport(
+        mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC,
+        status=MissionStatus.REACHED if ok else MissionStatus.FAILED, reason=why,
+        collisions=int(outside), path_length_m=metrics["path_length_m"], duration_s=t,
+        wall_s=time.monotonic() - wall0, steps=k, recording=rec.path, metrics=metrics,
+    )
+    return report, (field, products)

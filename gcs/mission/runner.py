@@ -1,0 +1,108 @@
+"""Run a mission file: pick the world, the planner and where it flies, return the report."""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from gcs.errors import UsageError
+from gcs.mission.kinematic import (
+    run_epbha_kinematic,
+    run_flock_kinematic,
+    run_radiation_kinematic,
+)
+from gcs.mission.planner_params import planner_setup
+from gcs.mission.recording import SUMMARY, MissionRecording
+from gcs.mission.report import MissionReport
+from gcs.mission.spec import MissionSpec, PlannerKind
+from gcs.mission.world import MissionWorld, load_world
+
+
+@dataclass(frozen=True, slots=True)
+class RunOptions:
+    """How to run a mission (the CLI's flags)."""
+
+    kinematic: bool = False
+    connect: str | None = None
+    mocap: str | None = None
+    record: bool = True
+    output: Path = Path("flights")
+    plot: Path | None = None
+    speedup: float | None = None  # None: the mission file's
+    seed: int | None = None
+
+
+def mission_world(spec: MissionSpec) -> MissionWorld:
+    """The mission's world (required: the planners and the evaluation need it)."""
+    if spec.world_path is None:
+        raise UsageError(f"{spec.path}: world: missing; expected world = \"../worlds/NAME.toml\"")
+    return load_world(spec.world_path)
+
+
+def _open_recorder(spec: MissionSpec, options: RunOptions, mode: str) -> Any:
+    from logs import Recorder, RecordingError
+
+    meta = {"command": "mission", "mission": spec.name, "planner": spec.planner.value,
+            "mode": mode, "mission_file": str(spec.path), "mission_text": spec.text}
+    try:
+        return Recorder(options.output, metadata=meta, vehicle=f"mission-{spec.name}")
+    except RecordingError as exc:
+        raise UsageError(f"-o {options.output}: {exc}") from None
+
+
+def run_mission(spec: MissionSpec, options: RunOptions,
+                progress: Callable[[str], None] | None = None) -> MissionReport:
+    """Fly the mission (kinematic world or vehicle), record it, write the plot; the report."""
+    mw = mission_world(spec)
+    setup = planner_setup(spec, mw.world.room.min_n[:2], mw.world.room.max_n[:2])
+    if options.seed is not None:
+        setup = type(setup)(**{**{f: getattr(setup, f) for f in setup.__dataclass_fields__},
+                               "seed": options.seed})
+    if not options.kinematic:
+        from gcs.mission.executor import run_on_vehicles
+
+        return run_on_vehicles(spec, mw, setup, options, progress)
+    with contextlib.ExitStack() as stack:
+        recorder = _open_recorder(spec, options, "kinematic") if options.record else None
+        if recorder is not None:
+            stack.callback(recorder.close)
+        rec = MissionRecording(recorder)
+        products: Any = None
+        if spec.planner is PlannerKind.EPBHA:
+            report = run_epbha_kinematic(spec, mw, setup, rec, progress)
+        elif spec.planner is PlannerKind.FLOCKING:
+            report = run_flock_kinematic(spec, mw, setup, rec, progress)
+        else:
+            report, products = run_radiation_kinematic(spec, mw, setup, rec, progress)
+        rec.put(SUMMARY, time.monotonic(), report.to_dict())
+    if spec.planner is PlannerKind.RADIATION and products is not None:
+        report.metrics["plot"] = write_radiation_plot(spec, options, report, products)
+    return report
+
+
+def plot_path(spec: MissionSpec, options: RunOptions, recording: str | None) -> Path:
+    """`--plot PATH`, else next to the recording, else in the output directory."""
+    if options.plot is not None:
+        return options.plot
+    if recording is not None:
+        return Path(recording).with_suffix(".png")
+    out = options.output if options.output.suffix != ".mcap" else options.output.parent
+    return out / f"{spec.name}.png"
+
+
+def write_radiation_plot(spec: MissionSpec, options: RunOptions, report: MissionReport,
+                         products: Any) -> str:
+    """The picture: true field, samples, path, found contour vs reference contour."""
+    from gcs.mission.plot import radiation_figure
+
+    field, prod = products
+    path = plot_path(spec, options, report.recording)
+    try:
+        radiation_figure(path, field, prod, title=f"{spec.name} ({report.mode.value})")
+    except OSError as exc:
+        raise UsageError(f"--plot {path}: cannot write ({exc.strerror or exc})") from None
+    return str(path)
