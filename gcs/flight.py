@@ -20,6 +20,10 @@ from firmware_link.records import FlightMode
 from gcs.errors import RuntimeFault
 from gcs.station import ControlMode, Station, StationSnapshot
 
+POLL_S = 0.1
+"""How often the flight script looks at the station. Rarely: every look takes the GIL, and a
+look preempted by the OS while holding it would delay the real-time loop thread."""
+
 
 class Phase(enum.Enum):
     """Where the flight is."""
@@ -144,7 +148,7 @@ class FlightRunner:
         clock = self.station.clock
         deadline = clock.now_s() + timeout_s
         while True:
-            snap = self.station.snapshot()
+            snap = self.station.snapshot(loop_stats=False)
             if self.station.error is not None:
                 raise RuntimeFault(f"control loop stopped: {self.station.error}")
             if pred(snap):
@@ -153,7 +157,7 @@ class FlightRunner:
                 self._on_progress(snap, self.phase)
             if clock.now_s() >= deadline:
                 raise RuntimeFault(f"{what} did not happen within {timeout_s:g} s")
-            time.sleep(0.02)
+            time.sleep(POLL_S)
 
     def _sleep(self, seconds: float) -> None:
         clock = self.station.clock
@@ -162,8 +166,8 @@ class FlightRunner:
             if self.station.error is not None:
                 raise RuntimeFault(f"control loop stopped: {self.station.error}")
             if self._on_progress is not None:
-                self._on_progress(self.station.snapshot(), self.phase)
-            time.sleep(0.02)
+                self._on_progress(self.station.snapshot(loop_stats=False), self.phase)
+            time.sleep(POLL_S)
 
     # -------------------------------------------------------------- the flight
     def arm(self) -> None:
@@ -181,7 +185,8 @@ class FlightRunner:
                 return
             except RuntimeFault:
                 if clock.now_s() >= deadline:
-                    reasons = [e.text for e in st.snapshot().events if "vehicle:" in e.text]
+                    reasons = [e.text for e in st.snapshot(loop_stats=False).events
+                               if "vehicle:" in e.text]
                     why = f" ({reasons[-1]})" if reasons else ""
                     raise RuntimeFault(f"vehicle did not arm within "
                                        f"{self.plan.arm_timeout_s:g} s{why}") from None
@@ -211,26 +216,33 @@ class FlightRunner:
         self.land()
 
     def land(self) -> None:
-        """Descend under PC control, then throttle to minimum near the floor and disarm."""
+        """Descend under PC control to a few cm, then hand over to LAND mode, which touches
+        down and disarms by itself (a disarm request follows if it does not)."""
         p = self.plan
         st = self.station
         self.phase = Phase.LAND
         self._target = 0.0
-        if st.snapshot().mode is not ControlMode.MANUAL:
+        if st.snapshot(loop_stats=False).mode is not ControlMode.MANUAL:
             st.alt_hold(True, 0.0, rate_mps=p.descent_mps)
-            start = st.snapshot().estimate
+            start = st.snapshot(loop_stats=False).estimate
             top = start.alt_m if start is not None else p.alt_m
             self._wait("descent", lambda s: s.estimate is not None
                        and s.estimate.alt_m < p.handover_alt_m, top / p.descent_mps + 15.0)
         st.set_sticks(1500, 1500, 1500, 1000)
         st.alt_hold(False)
-        self._sleep(1.0)
-        st.request_disarm()
+        st.set_mode(FlightMode.LAND)
         try:
-            self._wait("disarm", lambda s: not s.armed, 5.0)
+            self._wait("touch-down and disarm in LAND", lambda s: not s.armed, 15.0)
         except RuntimeFault:
-            st.request_disarm()
-            self._wait("disarm", lambda s: not s.armed, 5.0)
+            for _ in range(3):
+                st.request_disarm()
+                try:
+                    self._wait("disarm", lambda s: not s.armed, 3.0)
+                    break
+                except RuntimeFault:
+                    continue
+            else:
+                raise
         self.phase = Phase.DONE
 
     # -------------------------------------------------------------- scoring
