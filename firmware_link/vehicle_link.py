@@ -530,22 +530,27 @@ class VehicleLink:
         preferred = [s for s in texts if s.text.lower().startswith(("arm", "prearm", "disarm"))]
         return (preferred or texts)[-1].text
 
-    def arm(self, force: bool = False, timeout_s: float = 5.0) -> None:
-        """Arm and wait until the heartbeat says armed; LinkError with the vehicle's reason."""
-        self._arm_disarm(True, force, timeout_s)
+    def arm(self, force: bool = False, timeout_s: float = 5.0, *, retry: bool = False) -> None:
+        """Arm and wait until the heartbeat says armed; LinkError with the vehicle's reason.
 
-    def disarm(self, force: bool = False, timeout_s: float = 5.0) -> None:
+        With `retry`, a refusal (pre-arm checks still failing, e.g. just after boot) is asked
+        again every second until `timeout_s`; the last reason is in the error.
+        """
+        self._arm_disarm(True, force, timeout_s, retry)
+
+    def disarm(self, force: bool = False, timeout_s: float = 5.0, *, retry: bool = False) -> None:
         """Disarm and wait until the heartbeat says disarmed."""
-        self._arm_disarm(False, force, timeout_s)
+        self._arm_disarm(False, force, timeout_s, retry)
 
-    def _arm_disarm(self, want: bool, force: bool, timeout_s: float) -> None:
+    def _arm_disarm(self, want: bool, force: bool, timeout_s: float, retry: bool) -> None:
         verb = "arm" if want else "disarm"
         start = self._clock()
         deadline = start + timeout_s
         send = self.send_arm if want else self.send_disarm
         send(force)
-        resend_at = start + 1.0
+        sent_at, resend_at = start, start + 1.0
         hb_seen = self._hb_count
+        refusal = ""
         while True:
             for rec in self._step(deadline):
                 if (
@@ -553,21 +558,25 @@ class VehicleLink:
                     and rec.command == MAV_CMD_COMPONENT_ARM_DISARM
                     and rec.result in (MavResult.DENIED, MavResult.FAILED, MavResult.UNSUPPORTED)
                 ):
-                    reason = self._refusal_reason(start, deadline)
-                    raise LinkError(
+                    reason = self._refusal_reason(sent_at, deadline)
+                    refusal = (
                         f"vehicle {self._target_system} refused to {verb} "
                         f"({RESULT_TEXT[rec.result]}): {reason}"
                     )
+                    if not retry or rec.result == MavResult.UNSUPPORTED:
+                        raise LinkError(refusal)
             if self._hb_count > hb_seen and self._armed == want:
                 return
             now = self._clock()
             if now >= deadline:
                 raise LinkError(
-                    f"vehicle {self._target_system} did not {verb} within {timeout_s:.1f} s"
+                    f"{refusal} (kept refusing for {timeout_s:.1f} s)"
+                    if refusal
+                    else f"vehicle {self._target_system} did not {verb} within {timeout_s:.1f} s"
                 )
             if now >= resend_at:
                 send(force)
-                resend_at = now + 1.0
+                sent_at, resend_at = now, now + 1.0
 
     def set_mode(self, mode: FlightMode | int, timeout_s: float = 3.0) -> None:
         """Change mode and wait until the heartbeat confirms it."""

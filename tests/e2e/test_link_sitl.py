@@ -144,7 +144,7 @@ def test_link_flies_both_dialects(sitl: Sitl, transport: str) -> None:
 
         link.set_mode(FlightMode.STABILIZE)
         link.rc_override(RcCommand(throttle_us=1000))
-        link.arm(timeout_s=10.0)
+        link.arm(timeout_s=30.0, retry=True)  # pre-arm checks may still run after boot
         assert link.armed
         link.set_mode(FlightMode.ALT_HOLD)
         assert link.mode == FlightMode.ALT_HOLD
@@ -220,6 +220,19 @@ def test_signed_copter4_link_and_a_strangers_unsigned_override(tmp_path) -> None
                     select.select([], [], [], 0.025)
             assert seen and set(seen) == {1300}
             assert link.stats.signature_refusals == 0  # the vehicle signs everything it sends
+    finally:
+        sitl.stop()
+
+
+def test_signing_key_installed_by_setup_signing() -> None:
+    sitl = start_sitl("--tcp", "0", "--profile", "copter4")
+    try:
+        key = bytes(range(100, 132))
+        with VehicleLink.open(sitl.tcp, signing_key=key, install_signing_key=True) as link:
+            assert link.signing
+            link.set_mode(FlightMode.LAND)
+            assert link.mode == FlightMode.LAND
+            assert link.stats.signature_refusals == 0
     finally:
         sitl.stop()
 

@@ -126,6 +126,8 @@ def test_arm_refusal_carries_the_vehicles_reason() -> None:
         with VehicleLink.open(v.url) as link:
             with pytest.raises(LinkError, match="refused to arm \\(failed\\): PreArm: Throttle"):
                 link.arm(timeout_s=3.0)
+            with pytest.raises(LinkError, match=r"kept refusing for 1\.5 s"):
+                link.arm(timeout_s=1.5, retry=True)
             link.arm(force=True)  # 2989 bypasses the checks on 4.x
             assert link.armed
     finally:
