@@ -199,6 +199,7 @@ class Station:
         self._running = False
         self._error: BaseException | None = None
         self._listeners: list[Callable[[StationSnapshot], None]] = []
+        self._record_listeners: list[Callable[[TelemetryRecord], None]] = []
         self._empty_stats = self.loop.stats()
         self._snapshot = self._make_snapshot(self.clock.now_s(), -1)
 
@@ -239,6 +240,11 @@ class Station:
     def add_listener(self, fn: Callable[[StationSnapshot], None]) -> None:
         """Call `fn(snapshot)` on the loop thread after every tick (keep it cheap)."""
         self._listeners.append(fn)
+
+    def add_record_listener(self, fn: Callable[[TelemetryRecord], None]) -> None:
+        """Call `fn(record)` on the loop thread for every record polled (keep it cheap); the
+        snapshot keeps only the newest record of each type, this sees them all."""
+        self._record_listeners.append(fn)
 
     def _run(self) -> None:
         try:
@@ -424,6 +430,8 @@ class Station:
         rec = self.recorder
         for r in records:
             self._latest[type(r)] = r
+            for fn in self._record_listeners:
+                fn(r)
             if rec is not None:
                 topic = topics.topic_for(r)
                 if topic is not None:
