@@ -44,6 +44,9 @@ class SessionOptions:
     record: bool = True
     output: Path = Path("flights")
     sysids: tuple[int, ...] = (1,)
+    # The loop's clock spins the last stretch before a tick for precision, holding the GIL;
+    # a UI in the same process wants it back, so teleop trades a little jitter for it.
+    spin_s: float = 0.0015
     metadata: dict[str, Any] = field(default_factory=dict)
 
     def validate(self) -> None:
@@ -86,7 +89,8 @@ class StationSession:
         options.validate()
         self.options = options
         self.clock: Clock = (
-            MonotonicClock() if options.speedup == 1.0 else ScaledClock(options.speedup)
+            MonotonicClock(options.spin_s) if options.speedup == 1.0
+            else ScaledClock(options.speedup, options.spin_s)
         )
         self.vehicles: dict[int, Vehicle] = {}
         self.sitl_endpoints: Any = None

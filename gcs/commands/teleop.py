@@ -11,6 +11,9 @@ from pathlib import Path
 
 from gcs.session import SessionOptions, StationSession
 
+# No spinning before ticks: a spinning loop thread starves the UI thread of the GIL.
+TUI_SPIN_S = 0.0
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `teleop` subcommand."""
@@ -41,6 +44,7 @@ def options_from_args(args: argparse.Namespace) -> SessionOptions:
         command="teleop", connect=args.connect, mocap=args.mocap, profile=args.profile,
         world=args.world, serial=args.serial, seed=args.seed, config=args.config,
         signing_key=args.signing_key, record=args.record, output=args.output,
+        spin_s=TUI_SPIN_S,
     )
 
 
