@@ -133,13 +133,19 @@ class Autopilot:
             return
         self._param_version = self.params.version
         self.gains = Gains.from_params(self.params)
+        k = self.params.k
+        self._rc_override_time_s = (
+            k(Key.RC_OVERRIDE_TIME) if self.params.has_key(Key.RC_OVERRIDE_TIME) else 0.0
+        )
+        self._thr_hover_param = k(Key.THR_HOVER)
+        self._thr_min_param = k(Key.THR_MIN)
+        fs_value = int(k(Key.FS_GCS_ENABLE))
+        self._fs_gcs = GcsFailsafeAction(fs_value if 0 <= fs_value <= 3 else 0)
+        self._fs_batt_enabled = k(Key.FS_BATT_ENABLE) > 0
+        self._fs_batt_voltage = k(Key.FS_BATT_VOLTAGE)
         self.attitude.set_gains(self.gains)
         self.alt_ctrl.set_gains(self.gains)
         self.inav.tc_z_s = self.gains.inav_tc_z_s
-
-    def _hover_param(self) -> float:
-        v = self.params.k(Key.THR_HOVER)
-        return v / 1000.0 if self.profile is Profile.APM25 else v
 
     # ---- sticks ----------------------------------------------------------------------------
     def _throttle_stick(self) -> float:
@@ -263,7 +269,7 @@ class Autopilot:
             self.surface.reading(s.sonar_m, tilt_cos, g)
 
         if self.profile is Profile.COPTER4:
-            self.radio.expire(t_s, self.params.k(Key.RC_OVERRIDE_TIME))
+            self.radio.expire(t_s, self._rc_override_time_s)
         self._failsafes(t_s, s.battery_v)
 
         throttle, t_roll, t_pitch, yaw_rate = self._run_mode(dt_s, acc_up, tilt_cos)
@@ -328,7 +334,7 @@ class Autopilot:
             stick = self._throttle_stick()
             if self.profile is Profile.APM25:
                 thr = throttle_apm25(
-                    stick, self.params.k(Key.THR_HOVER), self.params.k(Key.THR_MIN)
+                    stick, self._thr_hover_param, self._thr_min_param
                 )
             else:
                 thr = throttle_copter4(stick, self.alt_ctrl.hover_throttle)
@@ -391,8 +397,7 @@ class Autopilot:
 
     def _failsafes(self, t_s: float, battery_v: float) -> None:
         st = self.state
-        fs_value = int(self.params.k(Key.FS_GCS_ENABLE))
-        action = GcsFailsafeAction(fs_value if 0 <= fs_value <= 3 else 0)
+        action = self._fs_gcs
         change = self.gcs.check(
             t_s,
             requires_override=self.profile is Profile.APM25,
@@ -422,8 +427,7 @@ class Autopilot:
             st.gcs_failsafe = False
             st.hold_for_gcs = False
             self.texts.append((Severity.INFO, "GCS Failsafe Cleared"))
-        enabled = self.params.k(Key.FS_BATT_ENABLE) > 0
-        if enabled and self.battery.check(t_s, battery_v, self.params.k(Key.FS_BATT_VOLTAGE)):
+        if self._fs_batt_enabled and self.battery.check(t_s, battery_v, self._fs_batt_voltage):
             st.battery_failsafe = True
             self.texts.append((Severity.CRITICAL, f"Battery failsafe: {battery_v:.2f}V"))
             if st.armed:

@@ -66,6 +66,9 @@ class StreamSchedule:
         self._msg_group = {m: g for g, ms in self._groups.items() for m in ms}
         self._override_s: dict[str, float | None] = {}  # None = disabled by SET_MESSAGE_INTERVAL
         self._next_due: dict[str, float] = {}
+        self._param_of = {m: f"SR{port}_{SR_SUFFIX[g]}" for m, g in self._msg_group.items()}
+        self._periods: dict[str, float] = {}
+        self._periods_version = -1
 
     def streamable(self, name: str) -> bool:
         """Whether `name` is a message this link can stream."""
@@ -95,22 +98,31 @@ class StreamSchedule:
         else:
             self._override_s[name] = max(1.0 / MAX_RATE_HZ, interval_us * 1e-6)
         self._next_due.pop(name, None)
+        self._periods_version = -1
         return True
 
     def interval_s(self, name: str) -> float | None:
         """Current period of a message, None when not streaming."""
         if name in self._override_s:
             return self._override_s[name]
-        rate = self.params.get(f"SR{self.port}_{SR_SUFFIX[self._msg_group[name]]}")
+        rate = self.params.get(self._param_of[name])
         return 1.0 / rate if rate > 0.0 else None
+
+    def _refresh_periods(self) -> None:
+        """Recompute every message's period when a parameter or interval changed."""
+        self._periods = {}
+        for name in self._msg_group:
+            period = self.interval_s(name)
+            if period is not None:
+                self._periods[name] = period
+        self._periods_version = self.params.version
 
     def due(self, t_s: float) -> list[str]:
         """Messages to send at `t_s` (each at most once per call)."""
         out: list[str] = []
-        for name in self._msg_group:
-            period = self.interval_s(name)
-            if period is None:
-                continue
+        if self._periods_version != self.params.version:
+            self._refresh_periods()
+        for name, period in self._periods.items():
             nxt = self._next_due.get(name)
             if nxt is None or t_s + 1e-9 >= nxt:
                 out.append(name)
