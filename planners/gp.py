@@ -141,6 +141,11 @@ class GaussianProcess:
         shape = xx.shape
         return np.concatenate(means).reshape(shape), np.concatenate(vars_).reshape(shape)
 
+    def predict_grid_mean(self, xs_m: np.ndarray, ys_m: np.ndarray) -> np.ndarray:
+        """Posterior mean on a grid, indexed ``[iy, ix]``."""
+        xx, yy = np.meshgrid(xs_m, ys_m)
+        return self.predict_mean(np.column_stack([xx.ravel(), yy.ravel()])).reshape(xx.shape)
+
     def gradient(self, xq: np.ndarray) -> np.ndarray:
         """Spatial gradient of the posterior mean at points xq (m, 2), shape (m, 2)."""
         xq = np.asarray(xq, dtype=float).reshape(-1, 2)

@@ -102,11 +102,12 @@ class RadiationMapperParams:
     min_sample_distance_m: float = 0.3
     max_sample_distance_m: float = 3.0
     dwell_s: float = 1.0  # detector integration per sample
+    height_m: float = 1.0  # flight height of the detector above the floor (sources)
     prospect_spacing_m: float = 4.0
     hotspot_separation_m: float = 1.5
     hotspot_contrast: float = 4.0  # a hotspot's peak is at least this times the background
     unexplained_z: float = 5.0  # Poisson z-score of a reading the known sources do not explain
-    unexplained_ratio: float = 1.5  # ... and reading / expected above this
+    unexplained_ratio: float = 1.3  # ... and reading / expected above this
     explained_radius_m: float = 2.0  # readings this close to a known hotspot are not candidates
     layer_ratio: float = 0.5**0.5  # successive layers differ by this factor
     n_layers: int = 6
@@ -594,7 +595,11 @@ class RadiationMapper:
         if not self._hotspots or len(self._cps) <= len(self._hotspots) + 1:
             return None
         centres = np.array([h.pos_n for h in self._hotspots])
-        return fit_point_sources(np.array(self._pos), np.array(self._cps), centres)
+        # The offset is the known flight height: fitted freely, it trades off against the
+        # strengths and lets a strong neighbour explain away a weaker, unseen source.
+        return fit_point_sources(
+            np.array(self._pos), np.array(self._cps), centres, (self.params.height_m,)
+        )
 
     def _next_candidate(self) -> np.ndarray | None:
         """The reading the known hotspots explain worst, if they clearly fail to explain it."""
@@ -617,6 +622,33 @@ class RadiationMapper:
             if any(np.linalg.norm(pos[k] - r) < p.hotspot_separation_m for r in self._rejected):
                 continue
             return pos[k]
+        return self._orphan_region_peak()
+
+    def _orphan_region_peak(self) -> np.ndarray | None:
+        """Peak of a model region above (a layer under) the level that holds no known hotspot.
+
+        Catches a source the point-source residuals hide, e.g. a weaker one beside a strong one:
+        the GP, fed by the readings around it, already draws a small region there.
+        """
+        p = self.params
+        if self._level is None or not self._hotspots:
+            return None
+        gp = self._fit()
+        xs = np.arange(p.x_min_m, p.x_max_m + 1e-9, 0.25)
+        ys = np.arange(p.y_min_m, p.y_max_m + 1e-9, 0.25)
+        mean = gp.predict_grid_mean(xs, ys)
+        region = region_above(xs, ys, mean, math.log(self._level * p.layer_ratio))
+        known = [shapely.Point(h.pos_n) for h in self._hotspots]
+        known += [shapely.Point(r) for r in self._rejected]
+        xx, yy = np.meshgrid(xs, ys)
+        for part in region.geoms:
+            if any(part.buffer(0.25).covers(k) for k in known):
+                continue
+            inside = shapely.contains_xy(part, xx, yy)
+            if not inside.any():
+                continue
+            j = int(np.argmax(np.where(inside, mean, -np.inf)))
+            return np.array([xx.flat[j], yy.flat[j]])
         return None
 
     def _crossing_radius(
