@@ -34,7 +34,10 @@ Where this code departs from the text, and why:
   ahead, toward the side whose sensor sees farther.
 - Obstacle classes count active sensors including up and down; a floor within 0.5 m is always
   "active" when flying low and does not stop a vehicle passing over, so the class uses the
-  overhead sensor only (a lid or table top above makes a cave).
+  overhead sensor only (a lid or table top above makes a cave). §8.1 assumes an approximate
+  maximum altitude indoors (`max_alt_m`): the vehicle never climbs above it, and a return
+  from above it is the ceiling, not a lid. A partition that cannot be passed over is gone
+  around on a free side; with no free side the vehicle backs out until one opens.
 - Diagonal back-off: a true diagonal step passes between two sensor cones, where nothing is
   seen; the back-off is a staircase of axis steps (back, side, back, …), each along a cone axis.
 - The "no detection range offset" of Subfunction 2 is `keep_off_m`: a move is taken only when
@@ -160,6 +163,7 @@ class EpbhaParams:
     keep_off_m: float = 0.25  # Subfunction 2's offset: the 0.15 m body plus 10 cm
     body_radius_m: float = 0.17  # edge clearance wanted: the 0.15 m body plus 2 cm
     max_visits: int = 4  # visits of one cell after which the planner reports a loop
+    max_alt_m: float = 2.0  # §8.1: the approximate maximum altitude indoors; never climb above
 
     def __post_init__(self) -> None:
         if not self.step_m > 0.0:
@@ -173,6 +177,8 @@ class EpbhaParams:
                 f"EPBHA step_m + keep_off_m ({self.step_m + self.keep_off_m} m) must be below "
                 f"the sensor range ({self.sensor_range_m} m), or a blocked move is never seen"
             )
+        if not self.max_alt_m > 0.0:
+            raise ValueError(f"EPBHA max_alt_m must be > 0, got {self.max_alt_m}")
         if self.body_radius_m < 0.0 or self.max_visits < 1:
             raise ValueError("EPBHA body_radius_m must be >= 0 and max_visits >= 1")
 
@@ -329,10 +335,23 @@ class Epbha:
         seen = reading.along_n(move.vec())
         return seen is not None and seen <= self.params.sensor_range_m
 
-    def classify(self, reading: ProximityReading, heading: Move) -> ObstacleClass:
-        """The obstacle class seen when `heading` is blocked (see the module docstring)."""
+    def _lid_seen(self, pos_n: Vec3, reading: ProximityReading, over: Move) -> bool:
+        """An obstacle overhead that is not the ceiling above the maximum altitude."""
+        seen = reading.along_n(over.vec())
+        if seen is None or seen > self.params.sensor_range_m:
+            return False
+        return over is not Move.UP or -pos_n[2] + seen < self.params.max_alt_m - 1e-9
+
+    def _can_bypass(self, pos_n: Vec3, reading: ProximityReading, over: Move) -> bool:
+        """The bypass step is free and, when climbing, stays below the maximum altitude."""
+        if over is Move.UP and -pos_n[2] + self.params.step_m > self.params.max_alt_m + 1e-9:
+            return False
+        return self._free(reading, over)
+
+    def classify(self, reading: ProximityReading, heading: Move, pos_n: Vec3) -> ObstacleClass:
+        """The obstacle class seen at `pos_n` when `heading` is blocked (module docstring)."""
         over = self._over_move(reading)
-        if self._active(reading, over):
+        if self._lid_seen(pos_n, reading, over):
             return ObstacleClass.CAVE
         a, b, _ = self.plane.value
         lateral_axis = b if heading.axis == a else a
@@ -380,7 +399,7 @@ class Epbha:
             if decision is not None:
                 return decision
 
-        keep_off = self._keep_off(reading)
+        keep_off = self._keep_off(pos, reading)
         if keep_off is not None:
             self._recoiled_from = keep_off.opposite
             return self._decide(self._neighbour(pos, keep_off), Status.MOVING, Reason.KEEP_OFF,
@@ -410,7 +429,7 @@ class Epbha:
 
     # --- manoeuvres -------------------------------------------------------------------
 
-    def _keep_off(self, reading: ProximityReading) -> Move | None:
+    def _keep_off(self, pos: Vec3, reading: ProximityReading) -> Move | None:
         """The move away from anything nearer than keep_off, when that evens the gap.
 
         In a gap narrower than twice keep_off (the goal under a table), backing off one side
@@ -427,6 +446,8 @@ class Epbha:
         if nearest is None:
             return None
         away = nearest[1].opposite
+        if away is Move.UP and -pos[2] + self.params.step_m > self.params.max_alt_m + 1e-9:
+            return None
         far = reading.along_n(away.vec())
         if far is None or far > nearest[0] + 2.0 * self.params.step_m + 1e-9:
             return away
@@ -440,7 +461,7 @@ class Epbha:
         table: tuple[CostEntry, ...],
         options: int,
     ) -> Decision:
-        kind = self.classify(reading, heading)
+        kind = self.classify(reading, heading, pos)
         side = self.lateral_toward_goal(pos, heading, reading)
         over = self._over_move(reading)
         man = _Manoeuvre(kind, heading, side, over)
@@ -505,7 +526,7 @@ class Epbha:
             if not above_lid:
                 man.clear_steps = 0
             if man.clear_steps <= self._margin_steps(man):
-                if self._free(reading, man.over):
+                if self._can_bypass(pos, reading, man.over):
                     return go(man.over, Reason.PASS_OVER)
                 # Cannot pass over: go around on a free side, else it is a box to back out of.
                 for side in (man.side, man.side.opposite):
@@ -519,10 +540,22 @@ class Epbha:
             return None
 
         # CAVE: staircase back and sideways until the overhead sensor is clear, then climb.
-        if not self._active(reading, man.over):
-            man.kind, man.stage, man.clear_steps = ObstacleClass.PARTITION, 1, 0
-            return self._continue_manoeuvre(pos, reading, options, table)
         back = man.heading.opposite
+        if not self._lid_seen(pos, reading, man.over):
+            if self._can_bypass(pos, reading, man.over):
+                man.kind, man.stage, man.clear_steps = ObstacleClass.PARTITION, 1, 0
+                return self._continue_manoeuvre(pos, reading, options, table)
+            # No lid but no room to climb either (walls up to the maximum altitude): back out
+            # straight until a side opens, then go around on it.
+            for side in (man.side, man.side.opposite):
+                if self._free(reading, side):
+                    man.kind, man.side, man.stage, man.clear_steps = (
+                        ObstacleClass.SINGLE_SIDED, side, 0, 0)
+                    return go(side, Reason.GO_AROUND)
+            if self._free(reading, back):
+                return go(back, Reason.BACK_OFF)
+            self._manoeuvre = None
+            return self._hover(pos, Reason.DEADLOCK_BLOCKED, options, ObstacleClass.CAVE, table)
         order = (back, man.side) if man.back_next else (man.side, back)
         for move in order:
             if self._free(reading, move):

@@ -103,9 +103,10 @@ def test_partition_is_passed_over() -> None:
 def test_lateral_view_of_the_same_wall_is_not_a_partition() -> None:
     # A wall 0.2 m ahead shows in a side cone no nearer than 0.2 / sin(22.5°) = 0.52 m.
     p = planner()
-    assert p.classify(reading(front=0.2, right=0.49), Move.NORTH) is ObstacleClass.SINGLE_SIDED
+    single = p.classify(reading(front=0.2, right=0.49), Move.NORTH, START)
+    assert single is ObstacleClass.SINGLE_SIDED
     # A wall 0.3 m ahead cannot show in a side cone within range: that is a wing.
-    assert p.classify(reading(front=0.3, right=0.49), Move.NORTH) is ObstacleClass.PARTITION
+    assert p.classify(reading(front=0.3, right=0.49), Move.NORTH, START) is ObstacleClass.PARTITION
 
 
 def test_cave_backs_off_diagonally_as_a_staircase() -> None:
@@ -238,3 +239,19 @@ def test_run_epbha_refuses_a_start_inside_an_obstacle() -> None:
     inside_table = (3.5, 2.0, -0.78)
     r = run_epbha(scene.world, inside_table, scene.goal_n)
     assert r.status is PlanStatus.START_BLOCKED and len(r.path) == 1
+
+
+def test_ceiling_high_wall_is_gone_around_below_the_maximum_altitude() -> None:
+    from planners.geometry import Box, World
+
+    room = Box("room", (0.0, 0.0, -2.5), (5.0, 3.0, 0.0))
+    # A wall to the ceiling with a wing: climbing is useless, the way is around its east end.
+    world = World(room, (
+        Box("wall", (2.5, 0.0, -2.5), (2.55, 2.2, 0.0)),
+        Box("wing", (1.9, 0.8, -2.5), (2.55, 0.85, 0.0)),
+    ))
+    params = EpbhaParams(max_alt_m=1.6)
+    r = run_epbha(world, (0.5, 1.2, -1.0), (4.5, 1.2, -1.0), params, max_steps=800)
+    assert r.status is PlanStatus.REACHED and r.collisions == 0
+    assert max(-p[2] for p in r.path) <= 1.6 + 1e-9
+    assert max(p[1] for p in r.path) > 2.2  # went around the east end
