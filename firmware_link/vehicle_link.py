@@ -105,6 +105,7 @@ class VehicleLink:
     heartbeat_period_s = 1.0
     lost_after_s = 1.5
     reconnect_backoff_s = (0.2, 0.4, 0.8, 1.6, 2.0)
+    reconnect_timeout_s = 2.0
     wait_step_s = 0.01
 
     def __init__(
@@ -139,6 +140,7 @@ class VehicleLink:
         self._reconnect_at_s = math.inf
         self._reconnect_try = 0
         self._connecting: socket.socket | None = None
+        self._connect_started_s = 0.0
         self._stream_rates: dict[str, float] = {}
         self._rate_probe: dict[str, list[float]] | None = None
         self._byte_probe: dict[str, int] = {}
@@ -201,7 +203,9 @@ class VehicleLink:
         while first is None:
             now = self._clock()
             if now >= deadline:
-                raise LinkError(f"{self.spec.url}: no vehicle heartbeat within {wait_s:.1f} s")
+                raise LinkError(
+                    f"{self.spec.url}: no vehicle heartbeat within {wait_s:.1f} s ({self._heard()})"
+                )
             if now >= self._next_gcs_hb_s:
                 self._send_gcs_heartbeat(now)
             self._wait_readable(deadline)
@@ -229,8 +233,20 @@ class VehicleLink:
         self._ep.wire = DIALECT_WIRE[self._dialect]
         self._event(now, LinkEventKind.CONNECTED, f"{self.spec.url}: vehicle {self._target_system}")
         self._event(now, LinkEventKind.DIALECT, DIALECT_TEXT[self._dialect])
-        self._setup_signing(deadline, install_key, bool(getattr(first, "_signed", False)))
         self._dispatch(first, now)
+        # A vehicle heartbeat is due within a second: give signing that long even when the
+        # first heartbeat came late in the wait.
+        signing_deadline = max(deadline, now + 2.5 * self.heartbeat_period_s)
+        self._setup_signing(signing_deadline, install_key, bool(getattr(first, "_signed", False)))
+
+    def _heard(self) -> str:
+        """What arrived while waiting, to tell a silent port from a wrong baud rate."""
+        t = self._ep.tally
+        if t.rx_bytes == 0:
+            return "nothing received"
+        if t.rx_messages == 0:
+            return f"{t.rx_bytes} bytes received, no valid MAVLink frame: wrong baud rate?"
+        return f"{t.rx_messages} frames received, none a vehicle heartbeat"
 
     def _setup_signing(self, deadline: float, install_key: bool, first_signed: bool) -> None:
         now = self._clock()
@@ -271,10 +287,15 @@ class VehicleLink:
                 msgs = self._ep.receive()
             except TransportClosed:
                 raise LinkError(f"{self.spec.url}: the peer closed the link") from None
+            signed_heartbeat = False
             for msg in msgs:
-                if msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == self._target_system:
-                    self._event(now, LinkEventKind.SIGNING, SIGNING_ON)
-                    return
+                self._dispatch(msg, now)
+                signed_heartbeat = signed_heartbeat or (
+                    msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == self._target_system
+                )
+            if signed_heartbeat:
+                self._event(now, LinkEventKind.SIGNING, SIGNING_ON)
+                return
 
     # ------------------------------------------------------------------ properties
     @property
@@ -418,11 +439,17 @@ class VehicleLink:
                 self._schedule_retry(now)
                 return
             if transport is None:
+                if now - self._connect_started_s > self.reconnect_timeout_s:
+                    # No answer at all (a host gone, not a port closed): try again later.
+                    self._connecting.close()
+                    self._connecting = None
+                    self._schedule_retry(now)
                 return
             self._connecting = None
         elif now >= self._reconnect_at_s:
             if self.spec.transport is Transport.TCP:
                 self._connecting = TcpTransport.start_connect(self.spec)
+                self._connect_started_s = now
                 if self._connecting is None:
                     self._schedule_retry(now)
                 return

@@ -340,3 +340,35 @@ class _UdpVehicle:
         self.thread.join()
         self.sock.close()
 
+
+
+def test_udpout_link_reaches_a_vehicle_that_answers_the_sender() -> None:
+    vehicle = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    vehicle.bind(("127.0.0.1", 0))
+    vehicle.settimeout(0.05)
+    mav = mavlink.MAVLink(None, 1, 1)
+    heartbeat = bytes(mav.heartbeat_encode(2, 3, 81, 0, 3, 3).pack(mav))
+    stop = threading.Event()
+    heard: list[bytes] = []
+
+    def serve() -> None:
+        # Like a UDP server endpoint: quiet until a station speaks, then answers it.
+        while not stop.is_set():
+            try:
+                data, addr = vehicle.recvfrom(512)
+            except TimeoutError:
+                continue
+            heard.append(data)
+            vehicle.sendto(heartbeat, addr)
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        url = f"udpout:127.0.0.1:{vehicle.getsockname()[1]}"
+        with VehicleLink.open(url, wait_heartbeat_s=3.0) as link:
+            assert link.dialect is Dialect.COPTER4 and link.target_system == 1
+        assert heard and heard[0][0] == 0xFE  # the station's greeting, before it knew
+    finally:
+        stop.set()
+        thread.join()
+        vehicle.close()
