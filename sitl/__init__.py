@@ -1,5 +1,6 @@
 """The bundled simulated vehicle: physics, ArduCopter-like autopilot, sensors, MAVLink endpoints."""
 
+from sitl.autopilot import FlightMode, Profile
 from sitl.battery import BatteryState
 from sitl.params import ParamError, VehicleParams
 from sitl.physics import PhysicsState
@@ -12,6 +13,7 @@ from sitl.sensors import (
     ProximitySample,
     SonarSample,
 )
+from sitl.simulation import MemoryLink, Simulation, VehicleRuntime
 from sitl.vehicle_model import SimVehicle, TruthState
 from sitl.world import (
     Box,
@@ -28,20 +30,25 @@ __all__ = [
     "BaroSample",
     "BatteryState",
     "Box",
+    "FlightMode",
     "FloorMaterial",
     "FloorPatch",
     "ImuSample",
+    "MemoryLink",
     "MocapSample",
     "ParamError",
     "PhysicsState",
+    "Profile",
     "ProximityFacing",
     "ProximitySample",
     "RadiationSource",
     "SensorParams",
     "SimVehicle",
+    "Simulation",
     "SonarSample",
     "TruthState",
     "VehicleParams",
+    "VehicleRuntime",
     "World",
     "WorldError",
     "default_world",

@@ -12,6 +12,7 @@ the GCS is silent and land when the battery failsafe trips.
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass
 
 from sitl.autopilot.profile import Profile
@@ -291,6 +292,8 @@ class ParamStore:
         """Set by name (integer types rounded as AP_Param stores them); returns the stored value."""
         i = self.index_of(name)
         spec = self._specs[i]
+        if not math.isfinite(value):
+            raise ParamError(f"{name}: value {value!r} is not a finite number")
         stored = float(round(value)) if spec.ptype is not ParamType.REAL32 else float(value)
         if spec.ptype is ParamType.INT8:
             stored = min(127.0, max(-128.0, stored))

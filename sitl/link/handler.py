@@ -70,7 +70,11 @@ class VehicleLink:
     def receive(self, ch: Channel, data: bytes) -> None:
         """Handle bytes that arrived on `ch`."""
         for msg in ch.feed(data):
-            self.handle(ch, msg)
+            try:
+                self.handle(ch, msg)
+            except (ValueError, OverflowError, TypeError):
+                # well-framed but meaningless (NaN where a number is needed, ...): drop, count
+                ch.codec.stats.rx_bad += 1
 
     def _for_me(self, target_system: int) -> bool:
         return target_system in (0, self.view.sysid)

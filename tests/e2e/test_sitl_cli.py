@@ -140,3 +140,32 @@ def test_copter4_signing_refuses_unsigned_overrides(tmp_path: Path) -> None:
     finally:
         st.close()
         assert sitl.stop() == 0
+
+
+def test_udp_endpoint_sends_to_the_station_and_answers_it(tmp_path: Path) -> None:
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", 0))
+    sock.settimeout(0.5)
+    port = sock.getsockname()[1]
+    sitl = SitlProcess(["--tcp", "0", "--udp", f"127.0.0.1:{port}", "--speedup", "2"], tmp_path)
+    mav = mavutil.mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+    mav.robust_parsing = True
+    try:
+        assert sitl.endpoint(1, "udp") == f"127.0.0.1:{port}"
+        kinds: set[str] = set()
+        deadline = time.monotonic() + 15.0
+        asked = False
+        while "ATTITUDE" not in kinds and time.monotonic() < deadline:
+            try:
+                data, addr = sock.recvfrom(65536)
+            except TimeoutError:
+                continue
+            kinds |= {m.get_type() for m in mav.parse_buffer(data) or []}
+            if "HEARTBEAT" in kinds and not asked:
+                req = mav.request_data_stream_encode(1, 1, 0, 5, 1).pack(mav, force_mavlink1=True)
+                sock.sendto(req, addr)  # answered to whoever talks to it
+                asked = True
+        assert {"HEARTBEAT", "ATTITUDE"} <= kinds
+    finally:
+        sock.close()
+        assert sitl.stop() == 0

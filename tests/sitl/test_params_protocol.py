@@ -85,3 +85,19 @@ def test_request_data_stream_sets_sr_parameters_and_caps_the_rate() -> None:
     gcs.run(0.1)
     msgs = gcs.run(2.0)
     assert {m.get_type() for m in msgs if m.get_srcComponent() == 1} == {"HEARTBEAT"}
+
+
+@pytest.mark.parametrize("profile", BOTH)
+def test_nonsense_values_are_dropped_and_counted(profile: Profile) -> None:
+    sim, gcs = make(profile)
+    nan = float("nan")
+    gcs.send(mavlink.MAVLink_param_set_message(1, 1, b"ANGLE_MAX", nan, 4))
+    gcs.send(mavlink.MAVLink_command_long_message(1, 1, 176, 0, nan, nan, 0, 0, 0, 0, 0))
+    gcs.send(mavlink.MAVLink_command_long_message(1, 1, 511, 0, nan, 1e30, 0, 0, 0, 0, 0))
+    gcs.send(mavlink.MAVLink_command_long_message(1, 1, 400, 0, nan, 0, 0, 0, 0, 0, 0))
+    msgs = gcs.run(1.2)
+    assert sim.vehicles[0].params.get("ANGLE_MAX") == 4500.0
+    assert gcs.of_type("HEARTBEAT", msgs)[-1].base_mode == 81
+    gcs.send(mavlink.MAVLink_param_request_read_message(1, 1, b"ANGLE_MAX", -1))
+    values = gcs.of_type("PARAM_VALUE", gcs.run(0.1))
+    assert [v.param_value for v in values] == [4500.0]  # still answering
