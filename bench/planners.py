@@ -71,6 +71,7 @@ def thesis_table() -> bool:
             failures.append(f"{scene.name}: EPBHA path is over 1.5x A*'s")
         if epbha.cost_evaluations * 10 > dstar.cost_evaluations:
             failures.append(f"{scene.name}: EPBHA uses under 10x fewer cost evaluations")
+    print("(A*: one planning step on the known map; its CPU includes building the grid)")
     print()
     if failures:
         print("FLOORS FAILED:")
@@ -111,6 +112,7 @@ def random_summary(rooms: int, seed: int) -> None:
     ratios: dict[str, list[float]] = {name: [] for name in PLANNERS}
     breakdown: collections.Counter[str] = collections.Counter()
     unreachable = 0
+    graze_m: list[float] = []
     for _ in range(rooms):
         scene = random_room(rng)
         results = run_all(scene)
@@ -128,6 +130,8 @@ def random_summary(rooms: int, seed: int) -> None:
             breakdown[f"{cause} ({where})"] += 1
         elif epbha.collisions:
             breakdown["reached, but grazed an obstacle within the body radius"] += 1
+        if epbha.collisions:
+            graze_m.append(epbha.min_clearance_m)
     print()
     print(f"Random cluttered rooms: {rooms} rooms, seed {seed} (30 % of boxes reach the ceiling)")
     header = (
@@ -147,7 +151,11 @@ def random_summary(rooms: int, seed: int) -> None:
             f"{statistics.mean(r.cost_evaluations for r in results):>12.0f}"
             f"{statistics.mean(cpu) * 1e3 if cpu else 0.0:>12.3f}{grazed:>14}{through:>12}"
         )
-    print(f"(goals A* proves unreachable on the grid: {unreachable})")
+    print(f"(goals A* proves unreachable on the grid: {unreachable}; A* plans in one step on the "
+          "known map, its CPU includes building the grid)")
+    if graze_m:
+        print(f"EPBHA's closest approach in a grazing run: {min(graze_m):.3f} m "
+              "(body radius 0.15 m; six 45° cones leave blind wedges between them)")
     print("EPBHA outcomes other than a clean arrival:")
     if not breakdown:
         print("  none")
