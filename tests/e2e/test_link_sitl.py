@@ -124,7 +124,7 @@ def test_link_flies_both_dialects(sitl: Sitl, transport: str) -> None:
         want = Dialect.APM25 if sitl.profile == "apm25" else Dialect.COPTER4  # type: ignore[attr-defined]
         assert link.dialect is want
         assert link.capacity_bytes_per_s == (None if transport == "tcp" else 11520.0)
-        report = link.bring_up(40.0)
+        report = link.bring_up(40.0, step_hold_s=0.3, final_window_s=1.0)
         print("\n".join(report.summary_lines()))
         assert report.confirmed
         if transport == "serial":
@@ -182,6 +182,22 @@ def test_watchdog_pause_and_restart_with_tcp_reopen() -> None:
         assert link.stats.reconnects >= 1
         assert not link.lost
         link.close()
+    finally:
+        sitl.stop()
+
+
+def test_watchdog_over_the_pseudo_terminal() -> None:
+    sitl = start_sitl("--tcp", "0", "--profile", "apm25")
+    try:
+        with VehicleLink.open(sitl.serial) as link:
+            hb = poll_until(link, lambda rs: any(isinstance(r, Heartbeat) for r in rs), 3.0)
+            sitl.proc.send_signal(signal.SIGSTOP)
+            records = poll_until(link, lambda rs: events(rs, LinkEventKind.LOST), 4.0)
+            last_hb = max(r.t_s for r in hb + records if isinstance(r, Heartbeat))
+            assert 1.5 <= events(records, LinkEventKind.LOST)[0].t_s - last_hb <= 2.0
+            sitl.proc.send_signal(signal.SIGCONT)
+            poll_until(link, lambda rs: events(rs, LinkEventKind.REGAINED), 4.0)
+            assert not link.lost
     finally:
         sitl.stop()
 
