@@ -32,6 +32,9 @@ class PositionControllerParams:
     yaw_rate_max_rps: float = math.radians(60.0)
     yaw_full_stick_rps: float = math.radians(202.5)  # ACRO_YAW_P 4.5 × 45°/s
     stick_half_range_us: int = 500
+    # RC1_DZ/RC2_DZ: ArduCopter reads +-30 us round centre as zero lean; without stepping over
+    # it, small corrections vanish and the hold limit-cycles (about 0.5 m on the bundled SITL)
+    stick_deadzone_us: int = 30
 
     def __post_init__(self) -> None:
         if not 0.0 < self.max_lean_rad <= self.angle_max_rad:
@@ -89,9 +92,13 @@ class PositionController:
         self.pid_e.reset()
         self._yaw_hold = None
 
-    def _stick(self, value: float, full_scale: float) -> int:
+    def _stick(self, value: float, full_scale: float, deadzone_us: int = 0) -> int:
         half = self.params.stick_half_range_us
-        return round(1500 + max(-1.0, min(1.0, value / full_scale)) * half)
+        frac = max(-1.0, min(1.0, value / full_scale))
+        if frac == 0.0:
+            return 1500
+        # the vehicle maps (pwm - 1500 -+ dz) over (half - dz) to the full deflection
+        return round(1500 + math.copysign(deadzone_us, frac) + frac * (half - deadzone_us))
 
     def update(self, setpoint: PositionSetpoint, pose: MocapPose, dt_s: float) -> PositionCommand:
         """One step against the latest motion-capture pose."""
@@ -119,9 +126,9 @@ class PositionController:
             pitch_rad=-nose_down,
             roll_rad=roll,
             yaw_error_rad=yaw_err,
-            roll_us=self._stick(roll, p.angle_max_rad),
+            roll_us=self._stick(roll, p.angle_max_rad, p.stick_deadzone_us),
             # pitch stick low = nose down: the stick follows the (nose-up positive) pitch angle
-            pitch_us=self._stick(-nose_down, p.angle_max_rad),
+            pitch_us=self._stick(-nose_down, p.angle_max_rad, p.stick_deadzone_us),
             yaw_us=self._stick(rate, p.yaw_full_stick_rps),
         )
 
