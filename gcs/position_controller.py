@@ -95,7 +95,7 @@ class PositionController:
     def _stick(self, value: float, full_scale: float, deadzone_us: int = 0) -> int:
         half = self.params.stick_half_range_us
         frac = max(-1.0, min(1.0, value / full_scale))
-        if frac == 0.0:
+        if abs(frac) < 1e-9:  # rounding noise of the heading rotation, not a command
             return 1500
         # the vehicle maps (pwm - 1500 -+ dz) over (half - dz) to the full deflection
         return round(1500 + math.copysign(deadzone_us, frac) + frac * (half - deadzone_us))
