@@ -17,6 +17,7 @@ from sitl.link.view import VehicleView
 
 COMPANION_COMPID = 158  # MAV_COMP_ID_PERIPHERAL
 TELEMETRY_QUEUE_BYTES = 2048
+REPLY_QUEUE_FRAMES = 2048  # a link nobody reads must not grow without bound
 
 
 class Channel:
@@ -62,6 +63,9 @@ class Channel:
     def send_reply(self, msg: Any) -> None:
         """Queue a must-deliver frame (ack, param, heartbeat, text)."""
         self._replies.append(self.codec.encode(msg))
+        if len(self._replies) > REPLY_QUEUE_FRAMES:
+            self._replies.popleft()
+            self.dropped += 1
 
     def send_telemetry(self, msg: Any, companion: bool = False) -> None:
         """Queue a periodic frame; the oldest go first when the queue is over budget."""
