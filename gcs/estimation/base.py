@@ -24,11 +24,14 @@ class EstimatorParams:
     initial_bias_sigma_mps2: float = 0.2
     gate_sigma: float = 4.0  # Kalman innovation gate, in innovation standard deviations
     gate_m: float = 0.3  # complementary filter's fixed innovation gate
-    reacquire_count: int = 6  # rejected readings in the window needed to reset to the sonar
-    reacquire_spread_m: float = 0.08  # max spread of those readings (steady sonar)
-    reacquire_window_s: float = 0.5
+    reacquire_count: int = 4  # rejected readings in the window needed to reset to the sonar
+    reacquire_spread_m: float = 0.1  # max spread of those readings (steady sonar)
+    reacquire_window_s: float = 3.0
     reacquire_min_s: float = 1.5  # rejections must last longer than the carpet's late echoes
-    duplicate_window_s: float = 0.2  # an identical distance within this time is a repeat
+    late_gap_s: float = 0.15  # a new reading after a longer silence is a late echo...
+    late_max_s: float = 1.4  # ...unless the silence outlasts any echo (then: a dropout ended)
+    late_sigma_m: float = 0.12  # extra noise of a late echo: its ping time is only bracketed
+    history_s: float = 2.0  # estimate history kept to place late echoes at their ping time
     stale_after_s: float = 0.25  # no accepted sonar for longer: coasting on the accelerometer
     ground_alt_m: float = 0.10  # below this estimate a zero sonar reading means "on the floor"
     sonar_offset_m: float = 0.0  # sonar mounted this far below the centre of gravity (body z)
@@ -94,7 +97,8 @@ class AltEstimator(ABC):
         self._acc_up = 0.0
         self._last_sonar_t_s = -math.inf
         self._last_distance: float | None = None
-        self._last_distance_t_s = -math.inf
+        self._last_new_t_s = -math.inf
+        self._history: deque[tuple[float, float]] = deque()  # (t_s, alt_m) after each predict
         self._rejected: deque[tuple[float, float]] = deque()  # (t_s, sonar alt), consecutive
         self._rejected_total = 0
         self._initialised = False
@@ -104,11 +108,11 @@ class AltEstimator(ABC):
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
 
     @abstractmethod
-    def _gate(self, z_alt_m: float) -> bool:
-        """True when the reading passes the innovation gate."""
+    def _gate(self, z_alt_m: float, extra_var_m2: float = 0.0) -> bool:
+        """True when the reading (with `extra_var_m2` more noise than usual) passes the gate."""
 
     @abstractmethod
-    def _correct(self, z_alt_m: float, t_s: float) -> None: ...
+    def _correct(self, z_alt_m: float, t_s: float, extra_var_m2: float = 0.0) -> None: ...
 
     @abstractmethod
     def _reset_alt(self, alt_m: float) -> None: ...
@@ -135,6 +139,9 @@ class AltEstimator(ABC):
         if dt > 0.0:
             self._predict(self._acc_up, dt)
         alt_before = self._state()[0]
+        self._history.append((t_s, alt_before))
+        while self._history[0][0] < t_s - p.history_s:
+            self._history.popleft()
 
         status = SonarStatus.NONE
         innovation = 0.0
@@ -157,9 +164,22 @@ class AltEstimator(ABC):
             rejected_total=self._rejected_total,
         )
 
+    def _alt_at(self, t_s: float) -> float:
+        """The estimate as it was at `t_s` (the oldest kept when older)."""
+        for t, alt in reversed(self._history):
+            if t <= t_s:
+                return alt
+        return self._history[0][1]
+
     def _sonar(self, sonar: Rangefinder, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
         p = self.params
-        d = sonar.distance_m
+        d = sonar.distance_m if sonar.valid else 0.0
+        # telemetry repeats the sensor's last reading at the stream rate: only a changed value
+        # is a new reading (a genuine repeat of the same value loses nothing)
+        fresh = d != self._last_distance
+        prev_new_t_s = self._last_new_t_s
+        if fresh:
+            self._last_distance, self._last_new_t_s = d, t_s
         in_range = sonar.valid and p.sonar_min_m <= d <= p.sonar_max_m
         if not in_range:
             if d <= p.sonar_min_m and alt_pred < p.ground_alt_m:
@@ -169,10 +189,17 @@ class AltEstimator(ABC):
                 self._last_sonar_t_s = t_s
                 return SonarStatus.GROUND, p.rest_alt_m - alt_pred
             return SonarStatus.INVALID, 0.0
-        if d == self._last_distance and t_s - self._last_distance_t_s < p.duplicate_window_s:
+        if not fresh:
             return SonarStatus.DUPLICATE, 0.0
-        self._last_distance, self._last_distance_t_s = d, t_s
         z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
+        extra_var = 0.0
+        if self._initialised and p.late_gap_s < t_s - prev_new_t_s <= p.late_max_s:
+            # The HC-SR04 does not ping again before an echo is back, so a reading after a long
+            # silence is a late echo of a ping sent about when the previous reading arrived
+            # (carpet, thesis ch. 7). Move it forward by the climb estimated since then, and
+            # trust it less: that climb is itself an estimate.
+            z += alt_pred - self._alt_at(prev_new_t_s)
+            extra_var = p.late_sigma_m**2
         innovation = z - alt_pred
         if not self._initialised:
             # the first in-range reading sets the altitude; nothing to gate it against yet
@@ -180,9 +207,9 @@ class AltEstimator(ABC):
             self._reset_alt(z)
             self._last_sonar_t_s = t_s
             return SonarStatus.USED, innovation
-        if self._gate(z):
+        if self._gate(z, extra_var):
             self._rejected.clear()
-            self._correct(z, t_s)
+            self._correct(z, t_s, extra_var)
             self._last_sonar_t_s = t_s
             return SonarStatus.USED, innovation
         self._rejected_total += 1

@@ -41,11 +41,13 @@ class ComplementaryEstimator(AltEstimator):
         self._pos_base += (self._v + 0.5 * dv) * dt_s
         self._v += dv
 
-    def _gate(self, z_alt_m: float) -> bool:
+    def _gate(self, z_alt_m: float, extra_var_m2: float = 0.0) -> bool:
         return abs(z_alt_m - (self._pos_base + self._pos_corr)) <= self.params.gate_m
 
-    def _correct(self, z_alt_m: float, t_s: float) -> None:
-        self._err = z_alt_m - (self._pos_base + self._pos_corr)
+    def _correct(self, z_alt_m: float, t_s: float, extra_var_m2: float = 0.0) -> None:
+        # a less certain reading drives the filter with a proportionally smaller error
+        r = self.params.sonar_sigma_m**2
+        self._err = (z_alt_m - (self._pos_base + self._pos_corr)) * r / (r + extra_var_m2)
         self._err_t_s = t_s
 
     def _reset_alt(self, alt_m: float) -> None:

@@ -29,10 +29,10 @@ class DeadReckoningEstimator(AltEstimator):
         self._h += self._v * dt_s + 0.5 * acc_up_mps2 * dt_s * dt_s
         self._v += acc_up_mps2 * dt_s
 
-    def _gate(self, z_alt_m: float) -> bool:
+    def _gate(self, z_alt_m: float, extra_var_m2: float = 0.0) -> bool:
         return abs(z_alt_m - self._h) <= self.params.gate_m
 
-    def _correct(self, z_alt_m: float, t_s: float) -> None:
+    def _correct(self, z_alt_m: float, t_s: float, extra_var_m2: float = 0.0) -> None:
         if self._prev_z is not None and t_s > self._prev_z[1]:
             self._v = (z_alt_m - self._prev_z[0]) / (t_s - self._prev_z[1])
         self._prev_z = (z_alt_m, t_s)

@@ -56,15 +56,15 @@ class KalmanEstimator(AltEstimator):
         n[2][2] += self.params.bias_walk_mps2_per_sqrt_s**2 * dt_s
         self._P = n
 
-    def _gate(self, z_alt_m: float) -> bool:
+    def _gate(self, z_alt_m: float, extra_var_m2: float = 0.0) -> bool:
         y = z_alt_m - self._x[0]
-        s = self._P[0][0] + self._R
+        s = self._P[0][0] + self._R + extra_var_m2
         return y * y <= self.params.gate_sigma**2 * s
 
-    def _correct(self, z_alt_m: float, t_s: float) -> None:
+    def _correct(self, z_alt_m: float, t_s: float, extra_var_m2: float = 0.0) -> None:
         P = self._P
         y = z_alt_m - self._x[0]
-        s = P[0][0] + self._R
+        s = P[0][0] + self._R + extra_var_m2
         k = [P[0][0] / s, P[1][0] / s, P[2][0] / s]
         self._x = [self._x[i] + k[i] * y for i in range(3)]
         row0 = P[0][:]
