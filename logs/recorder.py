@@ -190,6 +190,8 @@ class Recorder:
         self._sink.write_metadata(METADATA_NAME, encode_metadata(header))
         self._sink.flush()
         self._display_tf_written = False
+        self._last_log_ns: int | None = None
+        self._reported_drops = 0
         self._thread = threading.Thread(
             target=self._run, name=f"recorder-{vehicle}", daemon=True
         )
@@ -263,6 +265,8 @@ class Recorder:
         self._wake.set()
         self._thread.join()
         try:
+            if self._error is None:
+                self._note_drops()
             self._sink.close()
         except OSError as exc:
             self._error = self._error or f"{self._path}: {exc.strerror or exc}"
@@ -310,10 +314,25 @@ class Recorder:
         if self._error is not None:
             return
         try:
+            self._note_drops()
             self._sink.flush()
             self._flushes += 1
         except OSError as exc:
             self._error = f"{self._path}: {exc.strerror or exc}"
+
+    def _note_drops(self) -> None:
+        """Put new drops in the file itself as a warning, so a reader sees the hole."""
+        with self._drop_lock:
+            total = sum(self._dropped.values())
+        if total > self._reported_drops and self._last_log_ns is not None:
+            text = (
+                f"recorder queue full: dropped {total - self._reported_drops} messages "
+                f"({total} in all)"
+            )
+            message = foxglove_log(LogLevel.WARNING, text, self.vehicle)
+            self._write_foxglove(LOG_TOPIC, self._last_log_ns, message)
+            self._written[LOG_TOPIC] = self._written.get(LOG_TOPIC, 0) + 1
+            self._reported_drops = total
 
     def _write_item(self, kind: _Kind, topic: str, t_s: float, payload: Any) -> None:
         try:
@@ -321,6 +340,7 @@ class Recorder:
                 self._sink.write_metadata(topic, encode_metadata(payload))
                 return
             log_ns = self._anchor_ns + round(t_s * 1e9)
+            self._last_log_ns = log_ns
             if not self._display_tf_written:
                 # once, at the first message's time, so it spans the flight's timeline
                 self._write_foxglove(TF_TOPIC, log_ns, ned_display_transform())

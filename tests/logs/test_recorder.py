@@ -145,7 +145,11 @@ def test_full_queue_drops_and_counts(tmp_path: Path) -> None:
     stats = rec.stats
     assert stats.written.get("/burst", 0) + stats.dropped.get("/burst", 0) == n
     assert stats.dropped["/burst"] > 0
-    assert open_recording(rec.path).counts["/burst"] == stats.written["/burst"]
+    recording = open_recording(rec.path)
+    assert recording.counts["/burst"] == stats.written["/burst"]
+    warnings = [m["message"] for _t, _ns, m in recording.messages(["/log"])]
+    assert warnings and all("recorder queue full" in w for w in warnings)
+    assert warnings[-1].endswith(f"({stats.dropped['/burst']} in all)")  # the hole is in the file
 
 
 def test_put_after_close_is_counted_as_dropped(tmp_path: Path) -> None:
