@@ -103,6 +103,7 @@ class RadiationMapperParams:
     max_sample_distance_m: float = 3.0
     dwell_s: float = 1.0  # detector integration per sample
     height_m: float = 1.0  # flight height of the detector above the floor (sources)
+    max_fans_per_climb: int = 12
     prospect_spacing_m: float = 4.0
     hotspot_separation_m: float = 1.5
     hotspot_contrast: float = 4.0  # a hotspot's peak is at least this times the background
@@ -425,7 +426,9 @@ class RadiationMapper:
             0.5 * (p.y_min_m + p.y_max_m) - center[1], 0.5 * (p.x_min_m + p.x_max_m) - center[0]
         )
         areas: list[Polygon] = []
-        while d >= p.min_sample_distance_m:
+        for _ in range(p.max_fans_per_climb):
+            if d < p.min_sample_distance_m:
+                break
             grad = self._fit().gradient(center)[0]
             if np.linalg.norm(grad) > 1e-6:
                 heading = math.atan2(grad[1], grad[0])
@@ -444,7 +447,9 @@ class RadiationMapper:
             self._fan_maxima.append(best_cps)
             if best_cps > center_cps and not is_deadlock(best_pos, areas):
                 center, center_cps = best_pos, best_cps
-                d = min(d, sampling_distance_m(center_cps, self._start_cps, p))
+                # Back towards the eq. 10.12 distance, at most doubling: a refinement halving
+                # must not stick once the climb moves on, nor undo itself in one step.
+                d = min(2.0 * d, sampling_distance_m(center_cps, self._start_cps, p))
             else:
                 d *= 0.5
             areas.append(area)
@@ -640,15 +645,17 @@ class RadiationMapper:
         region = region_above(xs, ys, mean, math.log(self._level * p.layer_ratio))
         known = [shapely.Point(h.pos_n) for h in self._hotspots]
         known += [shapely.Point(r) for r in self._rejected]
-        xx, yy = np.meshgrid(xs, ys)
+        pos = np.array(self._pos)
+        cps = np.array(self._cps)
         for part in region.geoms:
             if any(part.buffer(0.25).covers(k) for k in known):
                 continue
-            inside = shapely.contains_xy(part, xx, yy)
-            if not inside.any():
-                continue
-            j = int(np.argmax(np.where(inside, mean, -np.inf)))
-            return np.array([xx.flat[j], yy.flat[j]])
+            # Only a reading above the layer is evidence; a part without one is the model
+            # extrapolating past its samples (typically along a wall).
+            inside = shapely.contains_xy(part.buffer(0.25), pos[:, 0], pos[:, 1])
+            strong = inside & (cps > self._level * p.layer_ratio)
+            if strong.any():
+                return pos[int(np.argmax(np.where(strong, cps, -np.inf)))]
         return None
 
     def _crossing_radius(
