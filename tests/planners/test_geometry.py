@@ -92,3 +92,17 @@ def test_noise_is_seeded_and_bounded() -> None:
 def test_reading_active_set() -> None:
     r = ProximityReading(0.2, None, 0.6, 0.5, None, 0.1)
     assert r.active(0.5) == {Facing.FRONT, Facing.LEFT, Facing.DOWN}
+
+
+def test_random_rooms_are_seeded_and_leave_start_and_goal_clear() -> None:
+    import numpy as np
+
+    from planners.scenes import random_room, thesis_scenes
+
+    a = random_room(np.random.default_rng(5))
+    b = random_room(np.random.default_rng(5))
+    assert a == b
+    assert a.world.clearance(a.start_n) >= 0.4 and a.world.clearance(a.goal_n) >= 0.4
+    for scene in thesis_scenes():
+        assert scene.world.in_room(scene.start_n, 0.15) and scene.world.in_room(scene.goal_n, 0.15)
+        assert scene.world.clearance(scene.goal_n) >= 0.15, scene.name
