@@ -99,7 +99,7 @@ def test_connect_detects_dialect_and_flies_the_basics(vehicle: FakeVehicle) -> N
 
 def test_bring_up_reaches_40_hz(vehicle: FakeVehicle) -> None:
     with VehicleLink.open(vehicle.url) as link:
-        report = link.bring_up(40.0, step_hold_s=0.15, final_window_s=0.8)
+        report = link.bring_up(40.0, step_hold_s=0.3, final_window_s=0.8)
         assert report.reached
         assert [s.period_ms for s in report.steps] == [100.0, 85.0, 70.0, 55.0, 40.0, 25.0]
         assert report.steps[-1].measured_hz == pytest.approx(40.0, rel=0.1)
