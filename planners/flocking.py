@@ -283,7 +283,7 @@ class FlockPlanner:
                 sp = self._make_way(k, p, sp, rd[k], reserved)
             reserved[k] = sp
             modes[self.ids[k]] = mode
-            self._note_blocking(k, mode)
+            self._note_blocking(k, mode, rd[k])
             if not self._states[k].individual:
                 sent += self.channel.offer(
                     step_index, k, self.formation.children(k), sp, avoiding
@@ -347,11 +347,14 @@ class FlockPlanner:
                 return False
         return True
 
-    def _note_blocking(self, k: int, mode: VehicleMode) -> None:
+    def _note_blocking(self, k: int, mode: VehicleMode, reading: ProximityReading) -> None:
         """Count steps the guard refused k's best move; long enough, k flies over the jam."""
         st = self._states[k]
         st.guard_blocked = st.guard_blocked + 1 if k in self._wanted else 0
-        free_to_climb = mode in (VehicleMode.FORMATION, VehicleMode.INDIVIDUAL)
+        # Only in the open: near walls (a queue at a door) climbing would scramble the queue.
+        free_to_climb = mode in (VehicleMode.FORMATION, VehicleMode.INDIVIDUAL) and not (
+            reading.active(self.params.formation.sensing_range_m)
+        )
         if st.guard_blocked >= self.params.overfly_after_steps and free_to_climb:
             st.overfly = True
 
@@ -420,7 +423,8 @@ class FlockPlanner:
             if self._guard_ok(k, sp, reserved):
                 return sp, primary_free
             self._wanted.setdefault(k, sp)
-        if k in self._wanted and cands:
+        in_the_open = not reading.active(self.params.formation.sensing_range_m)
+        if k in self._wanted and cands and in_the_open and not self._states[k].in_trail:
             return self._detour(k, p, cands[0][1], reading, reserved), primary_free
         return None, primary_free
 
@@ -514,7 +518,9 @@ class FlockPlanner:
         assert par is not None
         for msg in self.channel.deliver(step_index, k):
             slot = self.formation.slot_n(k, np.array(msg.pos_n[:2]), self.heading_n)
-            st.goal_n = (float(slot[0]), float(slot[1]), msg.pos_n[2])
+            # Slots are at cruise altitude: a leader's own layer or climb is not copied down the
+            # tree (it would stack layers generation after generation).
+            st.goal_n = (float(slot[0]), float(slot[1]), self.mission.common_goal_n[2])
             st.trail.append(msg.pos_n)
             while len(st.trail) > self.params.trail_points:
                 st.trail.popleft()
