@@ -362,7 +362,9 @@ class Recorder:
             self._error = f"{self._path}: {exc.strerror or exc}"
             self._dropped[topic] = self._dropped.get(topic, 0) + 1
             return
-        except (TypeError, ValueError, KeyError, RecursionError):
+        except Exception:
+            # A payload that cannot be written (wrong type, infinite time, unencodable value)
+            # is counted and skipped: one bad record must not stop the flight's recording.
             self._rejected[topic] = self._rejected.get(topic, 0) + 1
             return
         self._written[topic] = self._written.get(topic, 0) + 1

@@ -120,11 +120,14 @@ def test_nan_becomes_null_and_bad_payloads_are_counted_not_fatal(tmp_path: Path)
     with Recorder(tmp_path / "r.mcap", metadata={}) as rec:
         rec.put("/x", 1.0, {"alt_m": math.nan, "ok": 1.0})
         rec.put("/x", 1.1, 12345)  # neither dataclass nor dict
+        rec.put("/x", math.inf, {"alt_m": 1.0})  # no place on the timeline
+        rec.put("/x", 1.2, {"obj": object()})  # no JSON form: written as its text
     stats = rec.stats
-    assert stats.written["/x"] == 1
-    assert stats.rejected["/x"] == 1
-    (_t, _ns, msg), = open_recording(rec.path).messages(["/x"])
-    assert msg == {"alt_m": None, "ok": 1.0}
+    assert stats.written["/x"] == 2
+    assert stats.rejected["/x"] == 2
+    first, second = (m for _t, _ns, m in open_recording(rec.path).messages(["/x"]))
+    assert first == {"alt_m": None, "ok": 1.0}
+    assert second["obj"].startswith("<object object")
 
 
 def test_dict_payload_is_copied_at_put(tmp_path: Path) -> None:
