@@ -1,18 +1,17 @@
 """`quadgcs teleop`: fly and watch one vehicle from a terminal.
 
-With no `--connect` it starts the bundled SITL. The 25 ms loop runs on its own thread; the
-Textual app only reads snapshots and sends intents, so a slow terminal never stretches a tick.
+With no `--connect` it starts the bundled SITL. The 25 ms loop runs in its own process (see
+`gcs.tui.process_backend`); the Textual app only reads views and sends intents, so a slow
+terminal never stretches a tick.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
-from gcs.session import SessionOptions, StationSession
-
-# No spinning before ticks: a spinning loop thread starves the UI thread of the GIL.
-TUI_SPIN_S = 0.0
+from gcs.session import SessionOptions
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -44,25 +43,21 @@ def options_from_args(args: argparse.Namespace) -> SessionOptions:
         command="teleop", connect=args.connect, mocap=args.mocap, profile=args.profile,
         world=args.world, serial=args.serial, seed=args.seed, config=args.config,
         signing_key=args.signing_key, record=args.record, output=args.output,
-        spin_s=TUI_SPIN_S,
     )
 
 
 def run(args: argparse.Namespace) -> int:
-    """Bring the station up, run the app until the pilot quits, then take everything down."""
+    """Start the station process, run the app until the pilot quits, then take it all down."""
     from gcs.tui.app import make_app
-    from gcs.tui.station_backend import StationBackend
+    from gcs.tui.process_backend import ProcessBackend
 
-    with StationSession(options_from_args(args)) as session:
-        v = session.first
-        backend = StationBackend(
-            v.station, url=v.url,
-            recording=str(v.recorder.path) if v.recorder is not None else None,
-            dialect=v.link.dialect.value, signing=v.link.signing,
-        )
-        v.station.start()
+    backend = ProcessBackend(options_from_args(args))
+    try:
         make_app(backend).run()
-        if v.station.error is not None:
-            print(f"quadgcs teleop: control loop stopped: {v.station.error}")
-            return 1
+    finally:
+        backend.close()
+    if backend.error is not None:
+        text, code = backend.error
+        print(f"quadgcs teleop: {text}", file=sys.stderr)
+        return code
     return 0
