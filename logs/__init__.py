@@ -14,7 +14,7 @@ from logs.foxglove import (
     foxglove_vehicle_transform,
 )
 from logs.reader import Recording, open_recording
-from logs.recorder import Direction, Recorder, RecorderStats
+from logs.recorder import Direction, Recorder, RecorderStats, files_metadata
 
 __all__ = [
     "Direction",
@@ -25,6 +25,7 @@ __all__ = [
     "Recording",
     "RecordingError",
     "SceneBox",
+    "files_metadata",
     "foxglove_grid",
     "foxglove_log",
     "foxglove_pose",

@@ -136,6 +136,24 @@ def encode_metadata(metadata: Mapping[str, Any]) -> dict[str, str]:
     return out
 
 
+def files_metadata(**paths: str | Path | None) -> dict[str, str]:
+    """World/mission/config files for the metadata record: `world_path` and `world` (its text).
+
+    A missing or unreadable file is noted in place of its text rather than stopping a flight.
+    """
+    out: dict[str, str] = {}
+    for name, path in paths.items():
+        if path is None:
+            continue
+        p = Path(path)
+        out[f"{name}_path"] = str(p)
+        try:
+            out[name] = p.read_text(encoding="utf-8", errors="replace")
+        except OSError as exc:
+            out[name] = f"<unreadable: {exc.strerror or exc}>"
+    return out
+
+
 def _log_level(level: LogLevel | int | str) -> LogLevel:
     try:
         if isinstance(level, str):

@@ -216,3 +216,18 @@ def test_records_and_config_rebuild_for_a_rerun(tmp_path: Path) -> None:
     assert from_jsonable(Heartbeat, back["/vehicle/heartbeat"]) == beat
     assert from_jsonable(Heartbeat, back["/vehicle/heartbeat"]).system_status is SystemStatus.ACTIVE
     assert recording.metadata["estimator"] == {"complementary_tc_s": 1.0, "gate_m": 0.3}
+
+
+def test_world_and_mission_files_go_into_the_metadata_as_text(tmp_path: Path) -> None:
+    from logs import files_metadata
+
+    world = tmp_path / "room.toml"
+    world.write_text('[room]\nsize_m = [6.0, 4.0, 3.0]\n')
+    meta = files_metadata(world=world, mission=tmp_path / "gone.toml", config=None)
+    with Recorder(tmp_path / "r.mcap", metadata=meta) as rec:
+        rec.put("/x", 1.0, {"a": 1})
+    got = open_recording(rec.path).metadata
+    assert got["world"] == world.read_text()
+    assert got["world_path"] == str(world)
+    assert got["mission"].startswith("<unreadable")
+    assert "config" not in got
