@@ -1,4 +1,17 @@
-"""The only package that speaks MAVLink to the vehicle (pymavlink, pyserial)."""
+"""The only package that speaks MAVLink to the vehicle (pymavlink, pyserial).
+
+    link = VehicleLink.open("/dev/ttyUSB0,115200")   # or tcp:HOST:PORT, udpin:..., udpout:...
+    report = link.bring_up(40.0)                      # streams stepped 100 ms → 25 ms, measured
+    while flying:                                     # the station's 25 ms loop owns the link
+        records = link.poll()                         # typed records in SI units, never blocks
+        link.rc_override(RcCommand(throttle_us=...))
+    link.close()                                      # releases the overrides first
+
+Blocking helpers (`arm`, `set_mode`, `get_param`, `fetch_params`, `bring_up`) are for the
+loop's thread between ticks; `send_arm`/`send_disarm`/`send_set_mode` return at once and the
+outcome arrives as CommandAck / Heartbeat records. Errors are `LinkError` (exit 1) or
+`LinkUsageError` (exit 2), one line each.
+"""
 
 from firmware_link.connection import ConnectionSpec, Transport, parse_connection_string
 from firmware_link.dialect import dialect_of_frame

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from firmware_link import DataStream, LinkError, StreamWanted, plan_streams, wanted_streams
 from firmware_link.protocol import WireVersion, frame_overhead_bytes, payload_bytes
@@ -117,3 +119,37 @@ def test_measured_budget_limits_the_fast_rate_to_what_fits() -> None:
     plan = plan_streams(None, wanted_streams(Dialect.APM25), wire=WireVersion.V1, grouped=True)
     limited = step_plan(plan, 25.0, whole_hz=True, limit_hz=33.7)
     assert limited["ATTITUDE"] == 33.0 and limited["VFR_HUD"] == 10.0
+
+
+MESSAGES = ("ATTITUDE", "RAW_IMU", "RANGEFINDER", "VFR_HUD", "SYS_STATUS", "SERVO_OUTPUT_RAW")
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    capacity=st.floats(min_value=200.0, max_value=50_000.0),
+    picks=st.lists(
+        st.tuples(
+            st.sampled_from(MESSAGES),
+            st.floats(min_value=0.5, max_value=50.0),
+            st.floats(min_value=0.0, max_value=1.0),
+            st.sampled_from(list(DataStream)),
+        ),
+        min_size=1,
+        max_size=6,
+        unique_by=lambda t: t[0],
+    ),
+    grouped=st.booleans(),
+)
+def test_a_plan_never_exceeds_its_budget_nor_leaves_min_max(capacity, picks, grouped) -> None:
+    wanted = [StreamWanted(m, rate, rate * frac, group) for m, rate, frac, group in picks]
+    try:
+        plan = plan_streams(capacity, wanted, grouped=grouped, wire=WireVersion.V1)
+    except LinkError:
+        return  # the minimum rates did not fit: refused, as it should be
+    assert plan.total_bytes_per_s <= 0.8 * capacity * (1 + 1e-9)
+    for w in wanted:
+        rate = plan.rate_of(w.message)
+        members = [x for x in wanted if (x.group == w.group if grouped else x is w)]
+        group_min = max(x.min_rate_hz for x in members)
+        group_max = max(x.rate_hz for x in members)
+        assert group_min - 1e-9 <= rate <= group_max + 1e-9
