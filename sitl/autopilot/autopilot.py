@@ -34,6 +34,10 @@ YAW_DZ_US = 40
 GYRO_CAL_S = 1.0  # boot-time gyro calibration; arming is refused until it is done
 AUTO_DISARM_S = {Profile.APM25: 15.0, Profile.COPTER4: 10.0}
 SPIN_ARMED = {Profile.APM25: 0.07, Profile.COPTER4: 0.10}  # MOT_SPIN_ARMED 70 / MOT_SPIN_ARM
+BOOT_TEXTS = {
+    Profile.APM25: ("Initialising APM...", "APM:Copter V3.2.1", "Frame: PLUS"),
+    Profile.COPTER4: ("ArduCopter V4.5.7", "Frame: QUAD/PLUS"),
+}
 
 
 class Severity(enum.IntEnum):
@@ -117,7 +121,9 @@ class Autopilot:
         self.gcs = GcsWatch()
         self.battery = BatteryWatch()
         self.state = AutopilotState()
-        self.texts: list[tuple[Severity, str]] = []
+        self.texts: list[tuple[Severity, str]] = [
+            (Severity.INFO, text) for text in BOOT_TEXTS[profile]
+        ]
         self._t_s = 0.0
         self._zero_throttle_s = 0.0
         self._last_throttle = 0.0
