@@ -110,3 +110,24 @@ def test_export_without_raw_frames_is_refused(tmp_path) -> None:
         rec.put("/x", 1.0, {"a": 1})
     with pytest.raises(RecordingError, match="no raw MAVLink frames"):
         export_tlog(open_recording(rec.path), tmp_path / "x.tlog")
+
+
+def test_mavlink1_and_signed_mavlink2_frames_are_delimited(tmp_path) -> None:
+    """APM 2.5 speaks MAVLink 1 (0xFE); a signed MAVLink 2 frame carries 13 more bytes."""
+    v1 = bytes([0xFE, 3, 7, 1, 1, 0]) + b"abc" + b"\x11\x22"
+    v1_gcs = bytes([0xFE, 2, 8, 255, 190, 70]) + b"xy" + b"\x33\x44"
+    v2_signed = bytes([0xFD, 4, 0x01, 0, 9, 1, 1, 30, 0, 0]) + b"wxyz" + b"\x55\x66" + bytes(13)
+    v2 = bytes([0xFD, 1, 0, 0, 10, 255, 190, 70, 0, 0]) + b"q" + b"\x77\x88"
+    stamps = [1_700_000_000_000_000 + 25_000 * i for i in range(4)]
+    tlog = tmp_path / "mixed.tlog"
+    sent = (v1, v1_gcs, v2_signed, v2)
+    tlog.write_bytes(b"".join(t.to_bytes(8, "big") + f for t, f in zip(stamps, sent, strict=True)))
+    frames = list(read_tlog(tlog))
+    assert [f.data for f in frames] == list(sent)
+    assert [f.sysid for f in frames] == [1, 255, 1, 255]
+    assert [f.t_us for f in frames] == stamps
+    mcap = tmp_path / "mixed.mcap"
+    assert main(["logs", "import-tlog", str(tlog), "-o", str(mcap)]) == 0
+    assert open_recording(mcap).counts == {"/mavlink/rx": 2, "/mavlink/tx": 2}
+    assert export_tlog(open_recording(mcap), tmp_path / "back.tlog") == 4
+    assert (tmp_path / "back.tlog").read_bytes() == tlog.read_bytes()
