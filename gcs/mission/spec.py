@@ -55,6 +55,10 @@ class MissionSpec:
     max_duration_s: float
     profile: str
     text: str = field(repr=False, default="")
+    speedup: float = 1.0  # bundled SITL and station clock, times real time
+    position_tolerance_m: float = 0.08  # a set position is reached within this (mocap, 3-D)
+    settle_s: float = 0.4  # ... for this long (station clock)
+    step_timeout_s: float = 8.0  # a set position not reached by then counts as reached anyway
 
     @property
     def goal_n(self) -> Vec3 | None:
@@ -160,6 +164,15 @@ def load_mission(path: str | Path) -> MissionSpec:
     if profile not in ("apm25", "copter4"):
         raise r.fail("flight.profile", f"expected apm25 or copter4, got {profile!r}")
 
+    speedup = r.number(flight, "speedup", "flight.speedup", 1.0, positive=True)
+    if speedup > 50:
+        raise r.fail("flight.speedup", f"expected 0 < speedup <= 50, got {speedup!r}")
+    position_tolerance_m = r.number(flight, "position_tolerance_m", "flight.position_tolerance_m",
+                                    0.08, positive=True)
+    settle_s = r.number(flight, "settle_s", "flight.settle_s", 0.4, positive=True)
+    step_timeout_s = r.number(flight, "step_timeout_s", "flight.step_timeout_s", 8.0,
+                              positive=True)
+
     planner_table = data.get("planner")
     if not isinstance(planner_table, dict):
         raise r.fail("planner", "missing; expected a [planner] table with kind = ...")
@@ -187,6 +200,10 @@ def load_mission(path: str | Path) -> MissionSpec:
         max_duration_s=max_duration_s,
         profile=profile,
         text=text,
+        speedup=speedup,
+        position_tolerance_m=position_tolerance_m,
+        settle_s=settle_s,
+        step_timeout_s=step_timeout_s,
     )
 
 
