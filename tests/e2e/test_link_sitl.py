@@ -154,6 +154,9 @@ def test_link_flies_both_dialects(sitl: Sitl, transport: str) -> None:
         assert link.set_param("FS_GCS_ENABLE", 0.0) == 0.0
         assert link.get_param("FS_GCS_ENABLE") == 0.0
         link.set_param("FS_GCS_ENABLE", old)
+        if transport == "tcp":
+            params = link.fetch_params(timeout_s=20.0)
+            assert params["FS_GCS_ENABLE"] == old and len(params) > 20
         stats = link.stats
         assert stats.bad_frames == 0 and stats.signature_refusals == 0
 
