@@ -11,20 +11,28 @@ LEARNING (Section 10.4.1)
     then the next fan is centred on the strongest. The fan faces the gradient of a Gaussian-process
     model of the field (eqs. 10.7, 10.14–10.16). When no fan sample beats the centre, or the new
     centre falls back inside the last two coverage areas (deadlock), the fan distance halves; below
-    ``min_sample_distance_m`` the hotspot is found. Budget prediction and layer boundaries
-    (eqs. 10.17–10.21, Table 10.1) are computed on the fan maxima and reported.
+    ``min_sample_distance_m`` (or after ``max_fans_per_climb`` fans) the climb ends, and the model's
+    maximum nearby is the hotspot if it stands ``hotspot_contrast`` times above the background.
+    Budget prediction and layer boundaries (eqs. 10.17–10.21, Table 10.1) are computed on the fan
+    maxima and reported.
 PROSPECTING (extension)
     The thesis follows one gradient to one peak. To find every hotspot of a 1–5 source floor, the
     mapper samples a coarse lattice (``prospect_spacing_m``) where it has no sample yet, explains
-    all readings by the hotspots found so far as fitted inverse-square sources, and climbs (the
-    learning fans again) from the reading they explain worst while one stands out by a Poisson
-    z-score. (Local maxima of the GP were tried first: every isolated reading above the prior mean
-    is one, and climbing from them wasted a third of the samples.)
+    all readings by the hotspots found so far as inverse-square sources at the known flight height
+    (strengths and background by least squares), and climbs (the learning fans again) from the
+    reading they explain worst while one stands out by a Poisson z-score. Once the level is known,
+    a part of the model's region at a layer under it that holds no known hotspot but does hold a
+    reading above that layer is climbed too. The check repeats after every traced contour, and a
+    weaker hotspot found late lowers the level and restarts the tracing. (Local maxima of the GP
+    were tried first: every isolated reading above the prior mean is one, and climbing from them
+    wasted a third of the samples.)
 EXECUTING (Section 10.4.2)
     The contour level is the layer where intensity rises most sharply: on a ladder of levels under
     the weakest hotspot's peak, the one whose model contour has the steepest log-intensity gradient.
     Each hotspot's contour is followed with the cost of eq. 10.22 over five candidate positions,
-    diagonal ones weighted up, until the path has wound once around the hotspot.
+    diagonal ones weighted up, until the path has wound once around the hotspot. The map is the
+    GP's posterior mean on a grid and the contour its region at the level (contourpy), so separate
+    hotspots give a multi-polygon.
 
 Departures from the text, and why
 ---------------------------------
@@ -118,10 +126,11 @@ class RadiationMapperParams:
     diagonal_weight: float = 1.2  # Section 10.4.2: diagonal moves preferred
     stability_weight: float = 0.3  # W_c of eq. 10.22
     max_trace_steps: int = 40
-    map_resolution_m: float = 0.1
+    map_resolution_m: float = 0.2
+    reference_resolution_m: float = 0.05  # grid of the true field when scoring a run
     gp_lengthscales_m: tuple[float, ...] = (1.0, 1.5, 2.0, 3.0)
     gp_nugget: float = 0.002  # log-space model error on top of Poisson noise
-    gp_refit_every: int = 20
+    gp_refit_every: int = 40
 
     def __post_init__(self) -> None:
         """Reject parameter sets the mapper cannot fly."""
@@ -736,7 +745,9 @@ def evaluate_region(
     region: MultiPolygon, field_: RadiationField, level_cps: float, params: RadiationMapperParams
 ) -> _Evaluation:
     """IoU against the true field's region at ``level_cps`` and how many sources lie inside."""
-    xs, ys = params.map_axes()
+    r = params.reference_resolution_m
+    xs = np.arange(params.x_min_m, params.x_max_m + 0.5 * r, r)
+    ys = np.arange(params.y_min_m, params.y_max_m + 0.5 * r, r)
     reference = region_above(xs, ys, np.log(field_.grid(xs, ys)), math.log(level_cps))
     enclosed = int(np.sum(points_inside(region, field_.source_xy_m)))
     return _Evaluation(iou(region, reference), enclosed, reference, polygon_rings(region))
@@ -751,6 +762,8 @@ def run_radiation(
 ) -> RadiationResult:
     """Fly the mapper kinematically (perfect position hold) over an analytic field."""
     p = params or RadiationMapperParams()
+    if max_samples < 2:
+        raise ValueError(f"a map needs max_samples >= 2, got {max_samples}")
     mapper = RadiationMapper(p, max_samples=max_samples)
     pos = p.clip(np.asarray(start_n, dtype=float))
     path = [pos]
@@ -762,16 +775,7 @@ def run_radiation(
         path.append(pos)
     status = mapper.status or Status.FAILED
     budget, boundaries = mapper.budget()
-    try:
-        est = mapper.map_estimate()
-    except ValueError as exc:
-        empty = MultiPolygon()
-        return RadiationResult(
-            Status.FAILED, str(exc), mapper.samples, np.array(path), path_length_m(np.array(path)),
-            0.0, 0.0, 0, len(field_.sources), float("nan"), mapper.layers, budget, boundaries,
-            mapper.hotspots, [], empty, empty, np.zeros(0), np.zeros(0), np.zeros((0, 0)),
-            np.zeros((0, 0)),
-        )  # fmt: skip
+    est = mapper.map_estimate()
     ev = evaluate_region(est.region, field_, est.level_cps, p)
     explored = shapely.union_all(list(mapper.coverage_areas)).area if mapper.coverage_areas else 0.0
     path_arr = np.array(path)

@@ -152,3 +152,21 @@ def test_bad_parameters_are_rejected() -> None:
     with pytest.raises(ValueError):
         RadiationMapper(max_samples=0)
     assert math.isclose(RadiationMapperParams().floor_area_m2, 400.0)
+
+
+def test_five_sources_of_unequal_strength_are_all_enclosed() -> None:
+    field = RadiationField.from_tuples(
+        [(-6.0, -6.0, 3000.0), (5.0, -6.5, 7000.0), (0.5, 0.0, 4500.0), (-6.0, 5.5, 6000.0),
+         (6.0, 6.0, 2600.0)],
+        70.0,
+    )  # fmt: skip
+    r = run_radiation(field, None, np.random.default_rng(5), 400)
+    assert r.status is Status.REACHED, r.reason
+    assert r.sources_enclosed == 5 and len(r.hotspots) == 5
+    assert r.iou >= 0.85
+    assert r.level_cps < min(h.peak_cps for h in r.hotspots)
+
+
+def test_run_needs_room_for_a_map() -> None:
+    with pytest.raises(ValueError, match="max_samples"):
+        run_radiation(ONE, None, np.random.default_rng(0), max_samples=1)
