@@ -369,7 +369,7 @@ class RadiationMapper:
                 next(self._gen)
             ask = self._gen.send((pos, float(counts_per_s)))
         except StopIteration as stop:
-            self._finish(Status.REACHED, str(stop.value))
+            self._finish(Status.REACHED if self._hotspots else Status.FAILED, str(stop.value))
             return self._decision(pos, Phase.DONE, self._reason)
         if len(self._cps) >= self.max_samples:
             self._finish(Status.FAILED, f"sample budget of {self.max_samples} spent")
@@ -423,6 +423,8 @@ class RadiationMapper:
                     self._level = level
                     traced.clear()
                     done.clear()
+        if not self._hotspots:
+            return "no hotspot stands out from the background anywhere on the floor"
         return f"contour traced around {len(self._hotspots)} hotspot(s)"
 
     def _climb(

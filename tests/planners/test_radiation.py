@@ -170,3 +170,11 @@ def test_five_sources_of_unequal_strength_are_all_enclosed() -> None:
 def test_run_needs_room_for_a_map() -> None:
     with pytest.raises(ValueError, match="max_samples"):
         run_radiation(ONE, None, np.random.default_rng(0), max_samples=1)
+
+
+def test_a_floor_without_a_hotspot_fails_and_says_why() -> None:
+    faint = RadiationField.from_tuples([(0.0, 0.0, 20.0)], 50.0)
+    r = run_radiation(faint, None, np.random.default_rng(3), 400)
+    assert r.status is Status.FAILED
+    assert "no hotspot" in r.reason
+    assert r.hotspots == ()
