@@ -109,10 +109,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+EPILOG = """\
+What a ground station sees:
+  autopilot       sysid 1..N, compid 1; HEARTBEAT at 1 Hz; nothing else streams until
+                  REQUEST_DATA_STREAM (both profiles) or SET_MESSAGE_INTERVAL (copter4).
+                  apm25 = ArduCopter 3.2.1 (MAVLink 1 only); copter4 = ArduCopter 4.x.
+  stream params   SR0_* for the TCP link, SR1_* for the serial port, SR2_* for UDP.
+  RAW_IMU         acceleration in mg, rates in mrad/s (as ArduPilot sends them).
+  companion       compid 158 on each vehicle link, once a GCS has spoken: six IR
+                  DISTANCE_SENSOR (orientations 0,2,4,6,24,25; 51 cm = nothing in range)
+                  at 10 Hz, NAMED_VALUE_FLOAT "RAD_CPS" at 5 Hz when the world has sources.
+  motion capture  sysid 200, compid = tracked vehicle's sysid, ATT_POS_MOCAP at 100 Hz.
+  ground truth    SIMSTATE and SIM_STATE (EXTRA1 stream), for evaluation only.
+  FS_GCS_ENABLE   1: land when the GCS is silent for 5 s; 3 (this SITL): hold altitude
+                  until the battery failsafe, then land.
+"""
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Parser of `python -m sitl`."""
     parser = argparse.ArgumentParser(
-        prog="python -m sitl", description="Simulated ArduCopter quadrotors speaking MAVLink."
+        prog="python -m sitl",
+        description="Simulated ArduCopter quadrotors speaking MAVLink.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_arguments(parser)
     return parser
