@@ -20,6 +20,9 @@ from firmware_link.connection import ConnectionSpec, Transport
 from firmware_link.errors import LinkError
 
 READ_CHUNK_BYTES = 65536
+# One poll() parses at most this much (≈ 10 ms of pymavlink work); a backlog after a stall is
+# worked off over the next ticks instead of stalling one of them.
+READ_BUDGET_BYTES = 16384
 WRITE_TIMEOUT_S = 0.5
 
 
@@ -30,7 +33,7 @@ class TransportClosed(LinkError):
 class ByteTransport(Protocol):
     """What the link needs from a transport."""
 
-    def read(self) -> bytes: ...
+    def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes: ...
     def write(self, data: bytes) -> None: ...
     def wait_readable(self, timeout_s: float) -> None: ...
     def close(self) -> None: ...
@@ -101,12 +104,13 @@ class TcpTransport:
             raise OSError(code, "connect failed")
         return cls._ready(spec, sock)
 
-    def read(self) -> bytes:
-        """Whatever bytes have arrived; raises TransportClosed on EOF."""
-        chunks = []
-        while True:
+    def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes:
+        """Bytes that have arrived, up to `max_bytes`; raises TransportClosed on EOF."""
+        chunks: list[bytes] = []
+        room = max_bytes
+        while room > 0:
             try:
-                data = self._sock.recv(READ_CHUNK_BYTES)
+                data = self._sock.recv(min(room, READ_CHUNK_BYTES))
             except (BlockingIOError, InterruptedError):
                 break
             except OSError as exc:
@@ -116,8 +120,7 @@ class TcpTransport:
                     break
                 raise TransportClosed(f"{self.spec.url}: peer closed the connection")
             chunks.append(data)
-            if len(data) < READ_CHUNK_BYTES:
-                break
+            room -= len(data)
         return b"".join(chunks)
 
     def write(self, data: bytes) -> None:
@@ -181,10 +184,11 @@ class UdpTransport:
         """The bound port (useful with udpin:...:0)."""
         return int(self._sock.getsockname()[1])
 
-    def read(self) -> bytes:
-        """All datagrams waiting, concatenated (MAVLink frames never span datagrams)."""
-        chunks = []
-        while True:
+    def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes:
+        """Datagrams waiting (whole ones, about `max_bytes`), concatenated."""
+        chunks: list[bytes] = []
+        room = max_bytes
+        while room > 0:
             try:
                 data, addr = self._sock.recvfrom(READ_CHUNK_BYTES)
             except (BlockingIOError, InterruptedError):
@@ -195,6 +199,7 @@ class UdpTransport:
             if self.spec.transport is Transport.UDPIN:
                 self._peer = addr
             chunks.append(data)
+            room -= len(data)
         return b"".join(chunks)
 
     def write(self, data: bytes) -> None:
@@ -249,19 +254,20 @@ class SerialTransport:
             raise LinkError(f"{spec.url}: cannot open serial port: {exc}") from None
         return cls(spec, port)
 
-    def read(self) -> bytes:
-        """Whatever bytes are waiting; raises TransportClosed when the device vanished."""
+    def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes:
+        """Bytes waiting, up to `max_bytes`; raises TransportClosed when the device vanished."""
         try:
             waiting = self._port.in_waiting
             if not waiting:
                 readable, _, _ = select.select([self._port.fileno()], [], [], 0)
                 if not readable:
                     return b""
-                data = self._port.read(READ_CHUNK_BYTES)
+                # Readable with nothing waiting: either a race or the far end hung up.
+                data = self._port.read(max_bytes)
                 if not data:
                     raise TransportClosed(f"{self.spec.url}: serial device closed")
                 return bytes(data)
-            return bytes(self._port.read(waiting))
+            return bytes(self._port.read(min(waiting, max_bytes)))
         except (serial.SerialException, OSError) as exc:
             raise TransportClosed(f"{self.spec.url}: serial device lost: {exc}") from None
 

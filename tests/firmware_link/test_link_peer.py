@@ -372,3 +372,33 @@ def test_udpout_link_reaches_a_vehicle_that_answers_the_sender() -> None:
         stop.set()
         thread.join()
         vehicle.close()
+
+
+def test_a_backlog_is_worked_off_over_several_polls() -> None:
+    v = FakeVehicle("copter4", companion=False).start()
+    try:
+        with VehicleLink.open(v.url) as link:
+            link.poll()
+            sender = mavlink.MAVLink(None, 1, 1)
+            frames = []
+            for k in range(3000):  # ≈ 120 kB: several seconds of a fast serial link at once
+                msg = sender.attitude_encode(k, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0)
+                frames.append(bytes(msg.pack(sender)))
+                sender.seq = (sender.seq + 1) % 256
+            before = link.stats.rx_bytes
+            v.inject(b"".join(frames))
+            sizes: list[int] = []
+            deadline = time.monotonic() + 10
+            got = 0
+            while got < 3000 and time.monotonic() < deadline:
+                n = sum(1 for r in link.poll() if type(r).__name__ == "Attitude")
+                got += n
+                if n:
+                    sizes.append(n)
+                link._wait_readable(time.monotonic() + 0.005)
+            assert got == 3000
+            frame_bytes = len(frames[-1])
+            assert max(sizes) * frame_bytes <= 16384  # one poll parses one read budget at most
+            assert link.stats.rx_bytes - before >= sum(map(len, frames))
+    finally:
+        v.stop()
