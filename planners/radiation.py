@@ -58,9 +58,10 @@ Departures from the text, and why
 from __future__ import annotations
 
 import math
-from collections.abc import Generator
-from dataclasses import dataclass, field, replace
+from collections.abc import Generator, Mapping
+from dataclasses import dataclass, field, fields, replace
 from enum import Enum
+from typing import Any
 
 import numpy as np
 import shapely
@@ -144,6 +145,29 @@ class RadiationMapperParams:
             raise ValueError("layer_ratio must be in (0, 1)")
         if self.dwell_s <= 0.0 or self.map_resolution_m <= 0.0:
             raise ValueError("dwell_s and map_resolution_m must be > 0")
+
+    @classmethod
+    def from_toml(cls, data: Mapping[str, Any]) -> RadiationMapperParams:
+        """Parameters from a TOML table; unknown keys and non-numbers are errors."""
+        known = {f.name: f for f in fields(cls)}
+        kwargs: dict[str, Any] = {}
+        for key, value in data.items():
+            if key not in known:
+                raise ValueError(f"radiation mapper: unknown parameter {key!r}")
+            if key == "gp_lengthscales_m":
+                if not isinstance(value, list | tuple) or not value:
+                    raise ValueError(f"{key}: expected a list of lengths in metres, got {value!r}")
+                value = tuple(value)
+                items = value
+            else:
+                items = (value,)
+            if any(isinstance(v, bool) or not isinstance(v, int | float) for v in items):
+                raise ValueError(f"{key}: expected a number, got {value!r}")
+            if key in ("samples_per_fan", "n_layers", "max_trace_steps", "max_fans_per_climb",
+                       "gp_refit_every") and not isinstance(value, int):  # fmt: skip
+                raise ValueError(f"{key}: expected an integer, got {value!r}")
+            kwargs[key] = value
+        return cls(**kwargs)
 
     @property
     def floor_area_m2(self) -> float:

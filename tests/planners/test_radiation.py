@@ -178,3 +178,18 @@ def test_a_floor_without_a_hotspot_fails_and_says_why() -> None:
     assert r.status is Status.FAILED
     assert "no hotspot" in r.reason
     assert r.hotspots == ()
+
+
+def test_parameters_load_from_a_toml_table() -> None:
+    import tomllib
+
+    table = tomllib.loads(
+        "x_min_m = 0.0\nx_max_m = 20.0\nk1_gain_m = 2.5\nsamples_per_fan = 5\n"
+        "gp_lengthscales_m = [1.0, 2.0]\n"
+    )
+    p = RadiationMapperParams.from_toml(table)
+    assert (p.x_min_m, p.x_max_m, p.k1_gain_m, p.gp_lengthscales_m) == (0.0, 20.0, 2.5, (1.0, 2.0))
+    for bad in ({"k1_gain": 1.0}, {"k1_gain_m": "far"}, {"samples_per_fan": 4.5},
+                {"gp_lengthscales_m": 2.0}, {"dwell_s": True}):  # fmt: skip
+        with pytest.raises(ValueError):
+            RadiationMapperParams.from_toml(bad)
