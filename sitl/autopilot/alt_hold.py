@@ -18,6 +18,7 @@ ACCEL_Z_MAX_CMSS = 250.0  # target acceleration bound (PILOT_ACCEL_Z)
 ACCEL_FILT_HZ = 20.0
 HOVER_LEARN_TC_S = 2.0
 LEASH_CM = 300.0  # max altitude error kept in the target, as the firmware's leash
+TAKEOFF_JUMP_CM = 20.0  # AC_PosControl's takeoff target jump
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,13 @@ class AltitudeController:
         self._pid.reset()
         self._pid._integrator = (throttle_now - self.hover_throttle) * 1000.0
         self._acc_filtered = 0.0
+
+    def init_takeoff(self, alt_cm: float) -> None:
+        """Leaving the ground in ALT_HOLD: aim a little above and drop a negative I term,
+        so the motors go straight to hover rather than winding the integrator up first."""
+        self.target_alt_cm = alt_cm + TAKEOFF_JUMP_CM
+        if self._pid.integrator < 0.0:
+            self._pid.reset_i()
 
     def _stopping_distance_cm(self, vel_cms: float) -> float:
         p = max(self.gains.pos_z_p, 1e-3)

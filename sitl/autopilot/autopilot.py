@@ -352,6 +352,8 @@ class Autopilot:
             if not st.armed or (self.land.landed and climb <= 0.0):
                 self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
                 return 0.0, t_roll, t_pitch, yaw_rate
+            if self.land.landed and self._last_throttle <= 0.0:
+                self.alt_ctrl.init_takeoff(self.inav.alt_m * 100.0)
         else:  # LAND
             climb = -self.gains.land_speed_cms
             if not st.armed or self.land.landed:

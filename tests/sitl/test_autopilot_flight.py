@@ -305,3 +305,22 @@ def test_copter4_force_arm_and_in_flight_disarm_rules() -> None:
     assert gcs.of_type("COMMAND_ACK", msgs)[-1].result == 0
     pilot.fly(1.0)
     assert _mode(gcs)[1] == 81
+
+
+@pytest.mark.parametrize("profile", BOTH)
+def test_alt_hold_takes_off_on_the_stick_holds_and_comes_back_down(profile: Profile) -> None:
+    _sim, gcs = make(profile)
+    pilot = Pilot(gcs)
+    gcs.set_mode(1, int(FlightMode.ALT_HOLD))
+    pilot.fly(0.3)
+    ack = arm(gcs, pilot)
+    assert ack.result == 0
+    pilot.sticks[2] = 1800  # climb at about 1.2 m/s
+    assert truth_alt(gcs, pilot.fly(2.0)) > 1.5
+    pilot.sticks[2] = HOVER_STICK_US
+    pilot.fly(2.0)
+    alts = [truth_alt(gcs, pilot.fly(0.5)) for _ in range(6)]
+    assert max(alts) - min(alts) < 0.25
+    pilot.sticks[2] = 1000  # full descent rate
+    assert truth_alt(gcs, pilot.fly(6.0)) < 0.1
+    assert _mode(gcs)[:2] == (2, 209)
