@@ -23,6 +23,7 @@ from planners.geometry import Vec3
 from planners.proximity import Facing, ProximityReading
 
 PROXIMITY_STALE_S = 0.5  # a facing not heard from for this long reads "nothing seen"
+MAX_ALT_OFFSET_M = 1.5  # estimate (height over what is below) minus mocap altitude, at most
 ALT_RESEND_M = 0.01  # re-aim the altitude hold when the setpoint moved this much
 POLL_S = 0.1
 
@@ -134,6 +135,20 @@ class Craft:
         self.station.set_position_setpoint(PositionSetpoint(target_n[0], target_n[1]))
         self.refresh()
 
+    def release(self) -> None:
+        """Stop re-aiming the altitude hold (landing takes it over)."""
+        self._target_n = None
+
+    def wait(self, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> bool:
+        """Poll snapshots until `pred` holds (True) or `timeout_s` of station clock (False)."""
+        clock = self.station.clock
+        deadline = clock.now_s() + timeout_s
+        while clock.now_s() < deadline:
+            if pred(self.snapshot()):
+                return True
+            time.sleep(POLL_S)
+        return False
+
     def refresh(self) -> None:
         """Re-aim the altitude hold so that motion capture sees the target altitude.
 
@@ -148,6 +163,11 @@ class Craft:
         offset = 0.0
         if snap.estimate is not None and snap.mocap is not None:
             offset = snap.estimate.alt_m + snap.mocap.pos_n[2]
+            if abs(offset) > MAX_ALT_OFFSET_M:
+                raise RuntimeFault(f"vehicle {self.sysid}: altitude estimate "
+                                   f"{snap.estimate.alt_m:.2f} m disagrees with motion capture "
+                                   f"{-snap.mocap.pos_n[2]:.2f} m (more than "
+                                   f"{MAX_ALT_OFFSET_M} m: no furniture is that tall)")
         setpoint = -target[2] + offset
         if self._alt_sent_m is None or abs(setpoint - self._alt_sent_m) >= ALT_RESEND_M:
             self.station.alt_hold(True, setpoint)

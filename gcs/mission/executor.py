@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from firmware_link.records import FlightMode
 from gcs.errors import RuntimeFault
 from gcs.flight import FlightPlan, FlightRunner
 from gcs.mission.craft import Craft, go_to_all
@@ -51,6 +52,10 @@ from planners.radiation import RadiationMapper
 Progress = Callable[[str], None]
 POSITION_HOLD_FROM_M = 0.3  # take-off: hold position only once clear of the floor's friction
 TRAVEL_MPS = 0.5  # radiation legs: the timeout grows with the leg at this speed
+DESCENT_MPS = 0.3
+HANDOVER_ALT_M = 0.15  # below this (estimate), LAND mode finishes the touch-down
+STILL_MPS = 0.05  # sinking slower than this (mocap) for STILL_S: standing on something
+STILL_S = 1.0
 
 
 @dataclass(slots=True)
@@ -141,11 +146,51 @@ class _Flight:
         return hover
 
     def land(self) -> None:
-        """PC descent, LAND-mode touch-down and disarm, one vehicle after the other."""
+        """Land every vehicle, one after the other, where it is (see `_land_one`)."""
         for v, c in self.crafts.items():
             c.phase = "land"
             self.say(f"vehicle {v}: landing")
-            FlightRunner(c.station, FlightPlan(alt_m=self.spec.takeoff_alt_m, hold_s=1.0)).land()
+            self._land_one(c)
+
+    def _land_one(self, c: Craft) -> None:
+        """Descend under PC control until near the surface below or no longer sinking, then
+        LAND mode touches down and disarms (a disarm request follows if it does not).
+
+        Over a box the sonar-based estimate may still be measured from the floor, so it never
+        falls below the hand-over height: motion capture seeing no descent for a second ends the
+        PC descent too.
+        """
+        st = c.station
+        c.release()
+        st.alt_hold(True, 0.0, rate_mps=DESCENT_MPS)
+        deadline = self.clock.now_s() + self.spec.takeoff_alt_m / DESCENT_MPS + 20.0
+        still_since: float | None = None
+        last: tuple[float, float] | None = None  # (station time, mocap z)
+        while self.clock.now_s() < deadline:
+            snap = c.snapshot()
+            now = self.clock.now_s()
+            if snap.estimate is not None and snap.estimate.alt_m < HANDOVER_ALT_M:
+                break
+            z = snap.mocap.pos_n[2] if snap.mocap is not None else None
+            if z is not None and last is not None and now > last[0]:
+                sinking_mps = (z - last[1]) / (now - last[0])
+                if sinking_mps < STILL_MPS:
+                    still_since = now if still_since is None else still_since
+                    if now - still_since >= STILL_S:
+                        break
+                else:
+                    still_since = None
+            if z is not None:
+                last = (now, z)
+            time.sleep(0.1)
+        st.set_sticks(1500, 1500, 1500, 1000)
+        st.alt_hold(False)
+        st.set_mode(FlightMode.LAND)
+        for _ in range(4):
+            if c.wait(lambda s: not s.armed, 10.0):
+                return
+            st.request_disarm()
+        raise RuntimeFault(f"vehicle {c.sysid} did not disarm after landing")
 
     def go(self, targets: dict[int, Vec3], timeout_s: float | None = None) -> dict[int, Vec3]:
         """Fly to the targets; what the planner should take as each vehicle's position."""
