@@ -324,3 +324,20 @@ def test_alt_hold_takes_off_on_the_stick_holds_and_comes_back_down(profile: Prof
     pilot.sticks[2] = 1000  # full descent rate
     assert truth_alt(gcs, pilot.fly(6.0)) < 0.1
     assert _mode(gcs)[:2] == (2, 209)
+
+
+def test_copter4_setup_signing_turns_signing_on_and_apm25_ignores_it() -> None:
+    key = bytes(range(1, 33))
+    for profile, refused in ((Profile.COPTER4, True), (Profile.APM25, False)):
+        _sim, gcs = make(profile)
+        gcs.mavlink1 = False
+        gcs.send(mavlink.MAVLink_setup_signing_message(1, 1, key, 1))
+        gcs.mavlink1 = profile is Profile.APM25
+        gcs.override(1, 1500, 1500, 1700, 1500)  # unsigned
+        msgs = gcs.run(0.3)
+        name = "RC_CHANNELS" if profile is Profile.COPTER4 else "RC_CHANNELS_RAW"
+        chan3 = gcs.of_type(name, msgs)
+        if refused:
+            assert chan3[-1].chan3_raw == 1000
+        else:
+            assert chan3[-1].chan3_raw == 1700
