@@ -3,9 +3,11 @@
 The team is the binary tree of :mod:`planners.formation`. Each step, driven by every vehicle's
 position and its six IR readings:
 
-* the root leader moves one grid step ``d`` towards the common goal along one axis (Definition 7's
-  cost favours straight moves), avoiding what its sensors see with the obstacle classes of §9.3.3
-  (single-sided: sidestep towards the goal; partition: pass over; box: back off);
+* the root leader runs EPBHA (:mod:`planners.epbha`, Algorithm 9.3.3) one grid step ``d`` at a
+  time towards the common goal; should EPBHA report a dead end, it falls back to the flock's own
+  simpler rule, also used by ``SELF_AVOID`` followers: straight axis moves (Definition 7's cost)
+  and, when blocked, the obstacle classes of §9.3.3 (single-sided: sidestep towards the goal;
+  partition: pass over; box: back off);
 * every leader that is not avoiding sends its set position to its two followers (eq. 9.1), and
   nothing while it avoids; followers never answer;
 * a follower's goal is its triangle slot beside and behind the last position its leader sent; it
@@ -25,9 +27,11 @@ safe by the same rule. So the team never closes below the safe distance when veh
 set positions, whatever the planner above the guard decides.
 
 Departures from the text: the thesis's ``θ`` in "degree/100" and ``P(f1) = 1 − θ`` are not used
-(a probability from an angle in those units is not well defined); the leader classifies obstacles
-from active sensors as §9.3.3 says, but keeps a sidestep until its straight move is free plus two
-steps, since without that margin the body clips the corner it has just cleared. The leader's
+(a probability from an angle in those units is not well defined); the sidestep rule classifies
+obstacles from active sensors as §9.3.3 says, but keeps a sidestep until its straight move is free
+plus two steps, since without that margin the body clips the corner it has just cleared. A
+vehicle held by teammates for a few steps in the open flies over them (0.7 m up), and one in the
+way of a higher-priority teammate steps aside: the thesis has no rule for these jams. The leader's
 "obstacle" of eq. 9.1 is its avoidance manoeuvre, not any return on a sensor: a leader flying
 straight through a doorway with both side sensors lit still sends its positions, because they are
 the path its followers need.
@@ -42,6 +46,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from planners.epbha import Epbha, EpbhaParams, Reason, Status
 from planners.flock_comm import OpenLoopChannel
 from planners.formation import Formation, FormationParams, Role, rotate_f_to_n
 from planners.geometry import Vec3
@@ -57,6 +62,19 @@ AXIS_MOVES: tuple[Vec3, ...] = (
     (0.0, 0.0, -1.0),
 )
 _HORIZONTAL = (Facing.FRONT, Facing.RIGHT, Facing.BACK, Facing.LEFT)
+
+
+class LeaderAvoider(enum.Enum):
+    """How the root leader finds its way: EPBHA (Chapter 8, as Algorithm 9.3.3 says) or the
+    flock's own simpler sidestep rule."""
+
+    EPBHA = "epbha"
+    SIDESTEP = "sidestep"
+
+
+_EPBHA_AVOIDING = frozenset(
+    {Reason.KEEP_OFF, Reason.GO_AROUND, Reason.PASS_ALONG, Reason.PASS_OVER, Reason.BACK_OFF}
+)
 
 
 class FollowerPolicy(enum.Enum):
@@ -105,6 +123,8 @@ class FlockParams:
     overfly_after_steps: int = 4  # blocked this long by teammates, a vehicle flies over them
     overfly_height_m: float = 0.7  # above its goal altitude; more than the safe distance
     policy: FollowerPolicy = FollowerPolicy.HEADS_UP
+    leader_avoider: LeaderAvoider = LeaderAvoider.EPBHA
+    epbha: EpbhaParams = field(default_factory=EpbhaParams)
     latency_steps: int = 0
     formation: FormationParams = field(default_factory=FormationParams)
 
@@ -200,6 +220,8 @@ class FlockPlanner:
         self._states = [_State() for _ in range(self.n)]
         self._wanted: dict[int, Vec3] = {}  # guard-refused moves this step, by tree index
         self._start_pos: list[Vec3] = []
+        self._epbha: Epbha | None = None
+        self._epbha_failed = False
         g = mission.common_goal_n
         self._final_n: list[Vec3] = []
         for k in range(self.n):
@@ -509,8 +531,24 @@ class FlockPlanner:
         if _dist(p, goal) <= self.params.goal_tolerance_m:
             st.arrived_common = True
             return p, VehicleMode.WAITING
-        sp, avoiding = self._seek(0, p, goal, self.params.step_m, reading, reserved)
+        sp, avoiding = self._leader_move(p, goal, reading, reserved)
         return sp, VehicleMode.AVOIDING if avoiding else VehicleMode.FORMATION
+
+    def _leader_move(
+        self, p: Vec3, goal: Vec3, reading: ProximityReading, reserved: list[Vec3]
+    ) -> tuple[Vec3, bool]:
+        """The root's next set position towards ``goal`` and whether it is avoiding."""
+        use_epbha = self.params.leader_avoider is LeaderAvoider.EPBHA
+        if use_epbha and (self._epbha is None or self._epbha.goal_n != tuple(map(float, goal))):
+            self._epbha = Epbha(self.params.epbha, goal_n=goal, start_n=p)
+            self._epbha_failed = False
+        if self._epbha is not None and not self._epbha_failed:
+            decision = self._epbha.step(p, reading)
+            if decision.status is not Status.DEADLOCK:
+                return decision.next_pos_n, decision.reason in _EPBHA_AVOIDING
+            # EPBHA admits dead ends (§8.6); the sidestep rule takes over rather than hover.
+            self._epbha_failed = True
+        return self._seek(0, p, goal, self.params.step_m, reading, reserved)
 
     def _receive(self, step_index: int, k: int) -> None:
         st = self._states[k]
@@ -657,7 +695,10 @@ class FlockPlanner:
             st.arrived_final = True
             return p, VehicleMode.ARRIVED
         st.arrived_final = False
-        sp, avoiding = self._seek(k, p, target, self.params.step_m, reading, reserved)
+        if k == 0 and not st.overfly:
+            sp, avoiding = self._leader_move(p, target, reading, reserved)
+        else:
+            sp, avoiding = self._seek(k, p, target, self.params.step_m, reading, reserved)
         return sp, VehicleMode.AVOIDING if avoiding else VehicleMode.INDIVIDUAL
 
     def _formation_samples(self, pos: list[Vec3]) -> list[float]:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from planners.flock_comm import OpenLoopChannel, send_rule
-from planners.flocking import FlockMission, FlockParams, FlockPlanner, VehicleMode
+from planners.flocking import FlockMission, FlockParams, FlockPlanner, LeaderAvoider
 from planners.proximity import ProximityReading
 
 
@@ -29,40 +29,45 @@ def _wall_ahead(front_m: float) -> ProximityReading:
     return ProximityReading(front_m, None, None, None, None, None)
 
 
-def test_followers_wait_while_the_leader_avoids_then_catch_up() -> None:
+@pytest.mark.parametrize("avoider", list(LeaderAvoider))
+def test_followers_wait_while_the_leader_avoids_then_catch_up(avoider: LeaderAvoider) -> None:
     ids = [1, 2, 3]
-    planner = FlockPlanner(ids, FlockMission((20.0, 0.0, -1.0)), (1.0, 0.0))
+    params = FlockParams(leader_avoider=avoider)
+    planner = FlockPlanner(ids, FlockMission((20.0, 0.0, -1.0)), (1.0, 0.0), params)
     pos = planner.start_positions_n((4.0, 0.0, -1.0))
     clear = ProximityReading.clear()
     step = 0
 
-    def advance(leader_reading: ProximityReading) -> int:
+    def advance(leader_reading: ProximityReading) -> tuple[int, bool]:
         nonlocal step, pos
         out = planner.step(step, pos, {1: leader_reading, 2: clear, 3: clear})
         pos = out.setpoints_n
         step += 1
-        return out.messages_sent
+        return out.messages_sent, out.leader_avoiding
 
     for _ in range(5):
-        assert advance(clear) == 2  # one message to each follower per step
-    # The leader meets an obstacle: it sidesteps, sends nothing, the followers stop at the
-    # last goal they were given.
-    silent = [advance(_wall_ahead(0.32)) for _ in range(6)]
-    assert silent == [0] * 6
-    f2_before = pos[2]
-    assert advance(_wall_ahead(0.32)) == 0
-    assert pos[2] == f2_before
-    out = planner.step(step, pos, {1: _wall_ahead(0.32), 2: clear, 3: clear})
-    assert out.modes[2] is VehicleMode.WAITING and out.leader_avoiding
-    # Free again: messages resume and the followers boost (2 d per step) to their new slots.
-    leader_y = pos[1][1]
-    assert leader_y != 0.0  # it sidestepped
-    # The sidestep overshoots its corner by two steps, still silent.
-    overshoot = [advance(clear) for _ in range(FlockParams().sidestep_overshoot_steps)]
-    assert overshoot == [0] * FlockParams().sidestep_overshoot_steps
+        assert advance(clear) == (2, False)  # one message to each follower per step
+    # A wall ahead of the leader: it avoids, and eq. 9.1 sends nothing while it does.
+    f2_track = []
+    for _ in range(10):
+        sent, avoiding = advance(_wall_ahead(0.32))
+        assert avoiding and sent == 0
+        f2_track.append(pos[2])
+    # The followers went on to the last goal they were given, then waited there.
+    assert f2_track[-1] == f2_track[-2] == f2_track[-3]
+    assert pos[1][1] != 0.0  # the leader went round sideways
+    # The way is free again: messages resume and the followers boost (2 d per step).
+    resumed = False
+    for _ in range(20):
+        sent, avoiding = advance(clear)
+        assert (sent == 0) == avoiding
+        if sent:
+            resumed = True
+            break
+    assert resumed
     moves = []
     for _ in range(8):
         before = pos[2]
-        assert advance(clear) == 2
+        assert advance(clear)[0] == 2
         moves.append(float(np.linalg.norm(np.subtract(pos[2], before))))
-    assert max(moves) == pytest.approx(2 * FlockParams().step_m)
+    assert max(moves) == pytest.approx(2 * params.step_m)
