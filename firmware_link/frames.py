@@ -131,10 +131,13 @@ class FrameEndpoint:
         # Both encoders share one sequence so a dialect switch never looks like a gap.
         self._encoder_v1.seq = self.parser.seq = encoder.seq
         try:
-            self.transport.write(frame)
+            written = self.transport.write(frame)
         except TransportClosed:
             self.tally.tx_dropped += 1
             raise
+        if not written:  # a udpin link before the vehicle has spoken: nowhere to send
+            self.tally.tx_dropped += 1
+            return False
         self.tally.tx_messages += 1
         self.tally.tx_bytes += len(frame)
         if self._on_raw is not None:

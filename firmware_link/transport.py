@@ -34,7 +34,7 @@ class ByteTransport(Protocol):
     """What the link needs from a transport."""
 
     def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes: ...
-    def write(self, data: bytes) -> None: ...
+    def write(self, data: bytes) -> bool: ...
     def wait_readable(self, timeout_s: float) -> None: ...
     def close(self) -> None: ...
     def fileno(self) -> int: ...
@@ -123,7 +123,7 @@ class TcpTransport:
             room -= len(data)
         return b"".join(chunks)
 
-    def write(self, data: bytes) -> None:
+    def write(self, data: bytes) -> bool:
         """Send all of `data`; raises TransportClosed if the peer is gone."""
         view = memoryview(data)
         deadline = time.monotonic() + WRITE_TIMEOUT_S
@@ -139,6 +139,7 @@ class TcpTransport:
             except OSError as exc:
                 raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
             view = view[sent:]
+        return True
 
     def wait_readable(self, timeout_s: float) -> None:
         """Block until bytes arrive or `timeout_s` passes."""
@@ -202,13 +203,14 @@ class UdpTransport:
             room -= len(data)
         return b"".join(chunks)
 
-    def write(self, data: bytes) -> None:
+    def write(self, data: bytes) -> bool:
         """Send one datagram to the peer (dropped until a udpin peer has spoken)."""
         if self._peer is None:
-            return
+            return False
         # UDP is lossy by nature; the watchdog notices a dead peer.
         with contextlib.suppress(OSError):
             self._sock.sendto(data, self._peer)
+        return True
 
     def wait_readable(self, timeout_s: float) -> None:
         """Block until a datagram arrives or `timeout_s` passes."""
@@ -271,10 +273,11 @@ class SerialTransport:
         except (serial.SerialException, OSError) as exc:
             raise TransportClosed(f"{self.spec.url}: serial device lost: {exc}") from None
 
-    def write(self, data: bytes) -> None:
+    def write(self, data: bytes) -> bool:
         """Write all of `data`."""
         try:
             self._port.write(data)
+            return True
         except (serial.SerialException, OSError) as exc:
             raise TransportClosed(f"{self.spec.url}: serial write failed: {exc}") from None
 

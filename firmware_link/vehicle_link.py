@@ -203,8 +203,9 @@ class VehicleLink:
         while first is None:
             now = self._clock()
             if now >= deadline:
+                whose = "vehicle" if target_system is None else f"vehicle {target_system}"
                 raise LinkError(
-                    f"{self.spec.url}: no vehicle heartbeat within {wait_s:.1f} s ({self._heard()})"
+                    f"{self.spec.url}: no {whose} heartbeat within {wait_s:.1f} s ({self._heard()})"
                 )
             if now >= self._next_gcs_hb_s:
                 self._send_gcs_heartbeat(now)

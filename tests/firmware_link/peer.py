@@ -172,7 +172,7 @@ class FakeVehicle:
             except (OSError, ValueError):
                 continue  # a socket closed under us by crash()
             if not fds:
-                time.sleep(0.005)
+                self._stop.wait(0.005)
             for fd in readable:
                 with self._lock:
                     server, client = self._server, self._client
@@ -304,3 +304,14 @@ class FakeVehicle:
                 name.encode(), self.state.params[name], 9, len(names), names.index(name)
             )
         )
+
+
+def wait_until(predicate, timeout_s: float = 3.0) -> bool:
+    """Poll `predicate` until it holds or `timeout_s` passes; its last value."""
+    deadline = time.monotonic() + timeout_s
+    pause = threading.Event()
+    while not predicate():
+        if time.monotonic() >= deadline:
+            return bool(predicate())
+        pause.wait(0.005)
+    return True

@@ -23,7 +23,7 @@ from firmware_link.records import (
     Rangefinder,
     RcCommand,
 )
-from tests.firmware_link.peer import FakeVehicle
+from tests.firmware_link.peer import FakeVehicle, wait_until
 
 KEY = key_from_passphrase("quadgcs test key")
 
@@ -86,9 +86,7 @@ def test_connect_detects_dialect_and_flies_the_basics(vehicle: FakeVehicle) -> N
     assert chans == (1500, 1500, 2000, 1000, 65535, 65535, 65535, 65535)  # clamped
     # APM 2.5 must get the 8-channel MAVLink 1 form; 4.x trims trailing zeros of the v2 form.
     assert length == (18 if vehicle.profile == "apm25" else 22)
-    poll_deadline = time.monotonic() + 2
-    while len(vehicle.state.overrides) < 2 and time.monotonic() < poll_deadline:
-        time.sleep(0.01)
+    assert wait_until(lambda: len(vehicle.state.overrides) >= 2)
     assert vehicle.state.overrides[-1][2] == (0,) * 8  # close() released the channels
     stats = link.stats
     assert stats.tx_messages == sum(1 for d, _, _ in tapped if d == "tx")
@@ -231,9 +229,10 @@ def test_signed_link_works_and_a_strangers_unsigned_frames_are_refused() -> None
             v.inject(bytes(fake.pack(stranger)))
             poll_until(link, lambda rs: link.stats.signature_refusals > refused_before)
             assert link.mode == FlightMode.LAND  # the forged heartbeat changed nothing
-        # The station signed everything it sent: the vehicle refused nothing of ours.
+        # The station signed everything it sent, down to the release on close: the vehicle
+        # refused nothing of ours.
+        assert wait_until(lambda: "RC_CHANNELS_OVERRIDE" in v.state.rx_types)
         assert v.state.refused == 0
-        assert "RC_CHANNELS_OVERRIDE" in v.state.rx_types
     finally:
         v.stop()
 
@@ -284,9 +283,7 @@ def test_context_manager_releases_overrides_when_the_loop_crashes() -> None:
         with pytest.raises(RuntimeError), VehicleLink.open(v.url) as link:
             link.rc_override(RcCommand(throttle_us=1400))
             raise RuntimeError("loop crashed")
-        deadline = time.monotonic() + 2
-        while len(v.state.overrides) < 2 and time.monotonic() < deadline:
-            time.sleep(0.01)
+        assert wait_until(lambda: len(v.state.overrides) >= 2)
         assert v.state.overrides[-1][2] == (0,) * 8
         link.close()  # idempotent
     finally:
