@@ -25,6 +25,7 @@ from planners.proximity import Facing, ProximityReading
 PROXIMITY_STALE_S = 0.5  # a facing not heard from for this long reads "nothing seen"
 MAX_ALT_OFFSET_M = 1.5  # estimate (height over what is below) minus mocap altitude, at most
 ALT_RESEND_M = 0.01  # re-aim the altitude hold when the setpoint moved this much
+ALT_RATE_MPS = 0.4  # altitude set positions move at this rate (a jump upsets the estimator)
 POLL_S = 0.1
 
 
@@ -170,7 +171,7 @@ class Craft:
                                    f"{MAX_ALT_OFFSET_M} m: no furniture is that tall)")
         setpoint = -target[2] + offset
         if self._alt_sent_m is None or abs(setpoint - self._alt_sent_m) >= ALT_RESEND_M:
-            self.station.alt_hold(True, setpoint)
+            self.station.alt_hold(True, setpoint, rate_mps=ALT_RATE_MPS)
             self._alt_sent_m = setpoint
 
     def error_m(self, target_n: Vec3) -> float:
