@@ -399,3 +399,28 @@ def test_a_backlog_is_worked_off_over_several_polls() -> None:
             assert link.stats.rx_bytes - before >= sum(map(len, frames))
     finally:
         v.stop()
+
+
+def test_a_vanished_serial_device_is_retried_without_blocking_poll() -> None:
+    v = FakeVehicle("apm25", serial=True).start()
+    link = VehicleLink.open(v.url)
+    try:
+        link.poll()
+        v.stop()  # the far end of the serial line is gone (USB adapter pulled)
+        records = poll_until(
+            link,
+            lambda rs: events(rs, LinkEventKind.RECONNECTING) and events(rs, LinkEventKind.LOST),
+            timeout_s=4.0,
+        )
+        assert "reopening" in events(records, LinkEventKind.RECONNECTING)[0].detail
+        slowest = 0.0
+        for _ in range(50):  # reopen attempts fail fast and never stall the loop
+            start = time.monotonic()
+            link.poll()
+            slowest = max(slowest, time.monotonic() - start)
+            link._wait_readable(time.monotonic() + 0.01)
+        assert slowest < 0.05
+        assert not link.rc_override(RcCommand())  # nothing to send on: dropped and counted
+        assert link.stats.tx_dropped >= 1
+    finally:
+        link.close()
