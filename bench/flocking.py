@@ -2,8 +2,10 @@
 
 Prints one row per (scene, team size, planner): time to goal of the root leader and of the
 followers (mean / last), formation error, minimum separation, collisions, messages, throughput
-through the door, and how the run ended. Run from the repository root (``bench/planners.py``
-would shadow the package if run as a script): ``.venv/bin/python -m bench.flocking [sizes...]``.
+through the door, and how the run ended. In the door scene a third row flies the triangular flock
+on one level (``n_layers=1``), to show what the altitude layers change. Run from the repository
+root (``bench/planners.py`` would shadow the package if run as a script):
+``.venv/bin/python -m bench.flocking [sizes...]``.
 """
 
 from __future__ import annotations
@@ -15,7 +17,14 @@ import time
 import numpy as np
 
 from planners.flock_scenes import all_scenes
-from planners.flock_sim import FlockPlannerKind, FlockResult, run_flock
+from planners.flock_sim import (
+    FlockResult,
+    PlannerFactory,
+    reynolds_factory,
+    run_flock,
+    triangular_factory,
+)
+from planners.flocking import FlockParams
 
 MAX_STEPS = 1200
 SEED = 7
@@ -25,12 +34,12 @@ def _fmt(x: float | None, spec: str = ".1f") -> str:
     return "-" if x is None else format(x, spec)
 
 
-def _row(r: FlockResult, wall_s: float) -> str:
+def _row(label: str, r: FlockResult, wall_s: float) -> str:
     fol = [t for t in r.follower_times_s if t is not None]
     fol_mean = statistics.fmean(fol) if fol else None
     fol_last = max(fol) if len(fol) == len(r.follower_times_s) and fol else None
     return (
-        f"{r.scene:6} {r.n_vehicles:3d} {r.planner:10} {_fmt(r.leader_time_s):>7} "
+        f"{r.scene:6} {r.n_vehicles:3d} {label:10} {_fmt(r.leader_time_s):>7} "
         f"{_fmt(fol_mean):>7} {_fmt(fol_last):>7} {_fmt(r.formation_error_m, '.2f'):>6} "
         f"{r.min_separation_m:6.2f} {r.obstacle_collisions:4d} {r.vehicle_collisions:4d} "
         f"{r.messages_sent:8d} {_fmt(r.throughput_vps, '.2f'):>6}  "
@@ -47,10 +56,14 @@ def main(argv: list[str]) -> None:
     )
     for n in sizes:
         for scene in all_scenes():
-            for kind in FlockPlannerKind:
+            planners: list[tuple[str, PlannerFactory]] = [("triangular", triangular_factory())]
+            if scene.gate is not None:
+                planners.append(("tri-flat", triangular_factory(FlockParams(n_layers=1))))
+            planners.append(("reynolds", reynolds_factory()))
+            for label, factory in planners:
                 t0 = time.perf_counter()
-                r = run_flock(scene, n, kind, MAX_STEPS, np.random.default_rng(SEED))
-                print(_row(r, time.perf_counter() - t0), flush=True)
+                r = run_flock(scene, n, factory, MAX_STEPS, np.random.default_rng(SEED))
+                print(_row(label, r, time.perf_counter() - t0), flush=True)
 
 
 if __name__ == "__main__":
