@@ -42,7 +42,9 @@ from __future__ import annotations
 import enum
 import math
 from collections import deque
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any
 
 import numpy as np
 
@@ -137,6 +139,47 @@ class FlockParams:
             raise ValueError("n_layers must be >= 1 and layer_spacing_m >= 0")
         if self.overfly_height_m < self.formation.safe_distance_m:
             raise ValueError("overfly_height_m must be at least the safe distance")
+
+    @classmethod
+    def from_mapping(cls, data: Mapping[str, Any]) -> FlockParams:
+        """Defaults overridden by a parsed TOML table; [formation] and [epbha] sub-tables nest.
+
+        Unknown keys and bad enum names raise ValueError naming the key and what is allowed.
+        """
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(
+                f"flock params: unknown key(s) {unknown}; expected some of {sorted(known)}"
+            )
+        kw: dict[str, Any] = dict(data)
+        if "formation" in kw:
+            kw["formation"] = _sub_params(FormationParams, "formation", kw["formation"])
+        if "epbha" in kw:
+            kw["epbha"] = _sub_params(EpbhaParams, "epbha", kw["epbha"])
+        for key, enum_type in (("policy", FollowerPolicy), ("leader_avoider", LeaderAvoider)):
+            if key in kw:
+                try:
+                    kw[key] = enum_type(kw[key])
+                except ValueError:
+                    allowed = [e.value for e in enum_type]
+                    raise ValueError(
+                        f"flock params: {key} = {kw[key]!r}; expected one of {allowed}"
+                    ) from None
+        if "cost_weights" in kw:
+            kw["cost_weights"] = tuple(float(w) for w in kw["cost_weights"])
+        return cls(**kw)
+
+
+def _sub_params(cls: type, name: str, data: Any) -> Any:
+    """One nested parameter table from a mapping, unknown keys refused."""
+    if not isinstance(data, Mapping):
+        raise ValueError(f"flock params: [{name}] must be a table")
+    known = {f.name for f in fields(cls)}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise ValueError(f"flock params: unknown key(s) {unknown} in [{name}]")
+    return cls(**data)
 
 
 @dataclass(frozen=True, slots=True)
