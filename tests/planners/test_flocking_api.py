@@ -1,0 +1,74 @@
+"""The step API a mission runner drives, and the runner's refusals and books."""
+
+import numpy as np
+import pytest
+
+from planners.flock_scenes import FlockScene, open_hall, table_room
+from planners.flock_sim import FlockPlannerKind, run_flock
+from planners.flocking import FlockMission, FlockPlanner, Phase, VehicleMode
+from planners.formation import Role
+from planners.geometry import Box, World
+from planners.proximity import ProximityReading
+from planners.result import PlanStatus
+
+
+def test_step_keys_everything_by_vehicle_id() -> None:
+    ids = [11, 12, 13, 14, 15]
+    planner = FlockPlanner(ids, FlockMission((10.0, 0.0, -1.0)), (1.0, 0.0))
+    pos = planner.start_positions_n((2.0, 0.0, -1.0))
+    out = planner.step(0, pos, dict.fromkeys(ids, ProximityReading.clear()))
+    assert set(out.setpoints_n) == set(ids)
+    assert out.roles[11] is Role.LEADER and out.roles[12] is Role.RELAY
+    assert out.roles[15] is Role.FOLLOWER
+    assert out.phase is Phase.COMMON_GOAL
+    assert out.messages_sent == 4  # 11 → 12, 13 and 12 → 14, 15
+    assert out.setpoints_n[11] == pytest.approx((2.1, 0.0, -1.0))
+    assert out.modes[11] is VehicleMode.FORMATION
+
+
+def test_step_refuses_missing_vehicles_and_bad_teams() -> None:
+    planner = FlockPlanner([1, 2, 3], FlockMission((10.0, 0.0, -1.0)), (1.0, 0.0))
+    pos = planner.start_positions_n((2.0, 0.0, -1.0))
+    with pytest.raises(ValueError, match=r"no position or reading for \[3\]"):
+        planner.step(0, pos, {1: ProximityReading.clear(), 2: ProximityReading.clear()})
+    with pytest.raises(ValueError, match="unique"):
+        FlockPlanner([1, 1], FlockMission((10.0, 0.0, -1.0)), (1.0, 0.0))
+    with pytest.raises(ValueError, match="unknown vehicle ids"):
+        FlockPlanner([1, 2], FlockMission((10.0, 0.0, -1.0), {7: (0.0, 0.0, -1.0)}), (1.0, 0.0))
+
+
+def test_runner_refuses_bad_runs() -> None:
+    rng = np.random.default_rng(0)
+    with pytest.raises(ValueError, match="n_vehicles"):
+        run_flock(open_hall(), 0, FlockPlannerKind.TRIANGULAR, 10, rng)
+    with pytest.raises(ValueError, match="max_steps"):
+        run_flock(open_hall(), 3, FlockPlannerKind.TRIANGULAR, 0, rng)
+    hall = open_hall()
+    blocked = FlockScene(
+        "blocked",
+        World(hall.world.room, (Box("crate", (2.0, -1.0, -2.0), (3.6, 1.0, 0.0)),)),
+        hall.leader_start_n,
+        hall.common_goal_n,
+    )
+    with pytest.raises(ValueError, match="inside an obstacle"):
+        run_flock(blocked, 5, FlockPlannerKind.TRIANGULAR, 10, rng)
+
+
+def test_a_run_that_runs_out_of_steps_says_so() -> None:
+    r = run_flock(open_hall(), 3, FlockPlannerKind.TRIANGULAR, 20, np.random.default_rng(0))
+    assert r.status is PlanStatus.MAX_STEPS
+    assert "3 of 3 vehicles short" in r.reason
+    assert r.leader_time_s is None
+    assert r.track_n.shape == (21, 3, 3)
+
+
+def test_table_room_leader_ends_under_the_table() -> None:
+    scene = table_room()
+    r = run_flock(scene, 5, FlockPlannerKind.TRIANGULAR, 600, np.random.default_rng(0))
+    assert r.status is PlanStatus.REACHED, r.reason
+    assert r.collisions == 0
+    end = r.paths_n[1][-1]
+    top = next(b for b in scene.world.obstacles if b.name == "table-top")
+    assert top.min_n[0] < end[0] < top.max_n[0] and top.min_n[1] < end[1] < top.max_n[1]
+    assert end[2] > top.max_n[2]  # below the top (z is down)
+    assert r.messages_sent > 0 and r.formation_error_m is not None
