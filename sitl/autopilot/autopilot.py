@@ -53,6 +53,7 @@ class Severity(enum.IntEnum):
 class SystemStatus(enum.IntEnum):
     """MAV_STATE values the heartbeat reports."""
 
+    BOOT = 1
     STANDBY = 3
     ACTIVE = 4
     CRITICAL = 5
@@ -446,8 +447,10 @@ class Autopilot:
 
     @property
     def system_status(self) -> SystemStatus:
-        """STANDBY on the ground disarmed, ACTIVE armed, CRITICAL in a failsafe."""
+        """BOOT while calibrating, STANDBY disarmed, ACTIVE armed, CRITICAL in a failsafe."""
         st = self.state
+        if not self.calibrated:
+            return SystemStatus.BOOT
         if st.gcs_failsafe or st.battery_failsafe:
             return SystemStatus.CRITICAL
         return SystemStatus.ACTIVE if st.armed else SystemStatus.STANDBY

@@ -3,7 +3,8 @@
 RAW_IMU and SCALED_IMU carry acceleration in milli-g (value = a · 1000 / 9.80665) and rates in
 mrad/s, body FRD: this is what ArduPilot's send_raw_imu writes for every IMU including the APM
 2.5's MPU-6000/6050 (the chip's own LSB counts never leave the firmware), so a station converts
-with a_mss = xacc · 9.80665e-3 and w_rads = xgyro · 1e-3.
+with a_mss = xacc · 9.80665e-3 and w_rads = xgyro · 1e-3. (The thesis's eq. 5.1 converts the
+chip's LSB/g counts on its own Arduino; behind ArduPilot that conversion has already happened.)
 Ground truth goes out as SIMSTATE (attitude, lat/lng) and SIM_STATE (adds altitude and NED
 velocity). SIM_STATE is sent on apm25 too: it is a MAVLink 1 message and without it no truth
 altitude would leave the SITL in that profile.
@@ -24,6 +25,7 @@ MAV_TYPE_QUADROTOR = 2
 MAV_AUTOPILOT_ARDUPILOTMEGA = 3
 BASE_MODE_DISARMED = 81  # CUSTOM_MODE_ENABLED | STABILIZE_ENABLED | MANUAL_INPUT_ENABLED
 BASE_MODE_ARMED = 209  # + SAFETY_ARMED
+BASE_MODE_BOOT = 89  # what ArduCopter reports while it initialises (measured on 4.7)
 MAV_DISTANCE_SENSOR_ULTRASOUND = 1
 MAV_SENSOR_ROTATION_PITCH_270 = 25  # facing down
 
@@ -43,10 +45,16 @@ def _clamp16(x: float) -> int:
 def heartbeat(v: VehicleView) -> Any:
     """HEARTBEAT as ArduCopter sends it at 1 Hz."""
     st = v.autopilot.state
+    if st.armed:
+        base_mode = BASE_MODE_ARMED
+    elif not v.autopilot.calibrated:
+        base_mode = BASE_MODE_BOOT
+    else:
+        base_mode = BASE_MODE_DISARMED
     return mavlink.MAVLink_heartbeat_message(
         MAV_TYPE_QUADROTOR,
         MAV_AUTOPILOT_ARDUPILOTMEGA,
-        BASE_MODE_ARMED if st.armed else BASE_MODE_DISARMED,
+        base_mode,
         int(st.mode),
         int(v.autopilot.system_status),
         3,

@@ -83,7 +83,7 @@ def test_arming_is_refused_with_throttle_up(profile: Profile) -> None:
     ack = gcs.of_type("COMMAND_ACK", msgs)[-1]
     assert (ack.command, ack.result) == (ARM, 4)
     assert "Arm: Throttle too high" in [m.text for m in gcs.of_type("STATUSTEXT", msgs)]
-    assert _mode(gcs)[1] == 81
+    assert not _mode(gcs)[1] & 128  # SAFETY_ARMED clear
 
 
 @pytest.mark.parametrize("profile", BOTH)
@@ -341,3 +341,15 @@ def test_copter4_setup_signing_turns_signing_on_and_apm25_ignores_it() -> None:
             assert chan3[-1].chan3_raw == 1000
         else:
             assert chan3[-1].chan3_raw == 1700
+
+
+def test_heartbeat_reports_boot_until_the_gyros_are_calibrated() -> None:
+    from sitl.simulation import Simulation
+    from tests.sitl.flight_helpers import big_room
+
+    sim = Simulation(big_room(), Profile.APM25, 1, seed=2)
+    gcs = MemoryGcs(sim, sim.memory_link(1), mavlink1=True)
+    hbs = gcs.of_type("HEARTBEAT", gcs.run(2.5))
+    assert [(h.base_mode, h.system_status) for h in hbs] == [(89, 1), (89, 1), (81, 3)]
+    gcs.command(1, ARM, 1.0)  # nothing blocks arming any more
+    assert gcs.of_type("COMMAND_ACK", gcs.run(0.1))[-1].result == 0
