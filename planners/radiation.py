@@ -50,6 +50,8 @@ Departures from the text, and why
   used as a score to maximise, ``exp(-(x - mu)² / 2 sigma²) + W_c * D``, with ``x`` the model's
   predicted log-intensity at a candidate, ``mu`` the layer's, ``sigma`` the log-distance to the
   next layer, and ``D`` the model's predictive std there (sampling where the model is unsure).
+* A hotspot's position and peak come from a local inverse-square fit (``S / (d² + h²) + B``) to
+  the readings around it, not from the GP's maximum, which drifts towards where readings are dense.
 * The learning-phase layers of Table 10.1 come from noisy greedy fits and are reported only; the
   executing layer comes from the model's gradient, which also guarantees it lies below every
   hotspot so the contour encloses every source.
@@ -113,6 +115,7 @@ class RadiationMapperParams:
     dwell_s: float = 1.0  # detector integration per sample
     height_m: float = 1.0  # flight height of the detector above the floor (sources)
     max_fans_per_climb: int = 12
+    peak_search_radius_m: float = 1.0
     prospect_spacing_m: float = 4.0
     hotspot_separation_m: float = 1.5
     hotspot_contrast: float = 4.0  # a hotspot's peak is at least this times the background
@@ -424,20 +427,24 @@ class RadiationMapper:
         yield from self._prospect()
         yield from self._climb_candidates()
         traced: list[Polygon] = []
-        done: list[Hotspot] = []
+        done: set[int] = set()
+        self._refresh_hotspots()
         self._level = self._choose_level(self._fit())
         while True:
             pending = [
-                h
-                for h in self._hotspots
-                if h not in done and not any(self._covers(t, h) for t in traced)
+                i
+                for i, h in enumerate(self._hotspots)
+                if i not in done and not any(self._covers(t, h) for t in traced)
             ]
             if not pending:
                 break
             here = self._pos[-1]
-            nxt = min(pending, key=lambda h: float(np.linalg.norm(np.array(h.pos_n) - here)))
-            traced.append((yield from self._trace(nxt, self._level)))
-            done.append(nxt)
+            i = min(
+                pending,
+                key=lambda j: float(np.linalg.norm(np.array(self._hotspots[j].pos_n) - here)),
+            )
+            traced.append((yield from self._trace(self._hotspots[i], self._level)))
+            done.add(i)
             n_known = len(self._hotspots)
             yield from self._climb_candidates()
             if len(self._hotspots) != n_known:
@@ -514,6 +521,7 @@ class RadiationMapper:
             hot = yield from self._climb(pos, cps, "climbing a new hotspot")
             if not self._add_hotspot(hot):
                 self._rejected.append(cand)
+            self._refresh_hotspots()
 
     def _trace(
         self, hot: Hotspot, level: float
@@ -605,14 +613,57 @@ class RadiationMapper:
         return max(float(np.quantile(self._cps, 0.1)), 1.0 / self.params.dwell_s)
 
     def _peak_near(self, center: np.ndarray) -> Hotspot:
-        """Model maximum within one maximum fan distance of ``center``."""
+        """Model maximum within ``peak_search_radius_m`` of where a climb ended.
+
+        Kept small: a wider window can land on a stronger neighbour and lose this hotspot.
+        """
         p = self.params
-        r = p.max_sample_distance_m
-        g = np.linspace(-r, r, 31)
+        r = p.peak_search_radius_m
+        g = np.linspace(-r, r, 21)
         pts = np.array([p.clip(center + np.array([dx, dy])) for dx in g for dy in g])
         mean = self._fit().predict_mean(pts)
         k = int(np.argmax(mean))
         return Hotspot((float(pts[k, 0]), float(pts[k, 1])), float(math.exp(mean[k])))
+
+    def _refresh_hotspots(self) -> None:
+        """Re-locate every hotspot by a local inverse-square fit to the readings around it."""
+        for i, h in enumerate(self._hotspots):
+            self._hotspots[i] = self._refine_hotspot(h)
+
+    def _refine_hotspot(self, hot: Hotspot) -> Hotspot:
+        """Best source position within ``peak_search_radius_m``: ``S / (d² + h²) + B`` fitted.
+
+        The GP's maximum drifts towards wherever the readings around a peak happen to be dense;
+        the readings near a hotspot pin its position far better through the inverse-square law.
+        For every candidate position the weighted 2-parameter least squares is solved in closed
+        form, all candidates at once.
+        """
+        p = self.params
+        pos = np.array(self._pos)
+        cps = np.array(self._cps)
+        centre = np.array(hot.pos_n)
+        near = np.linalg.norm(pos - centre, axis=1) < p.peak_search_radius_m + 1.0
+        if np.count_nonzero(near) < 6:
+            return hot
+        x, z = pos[near], cps[near]
+        w = 1.0 / np.maximum(z, 1.0)  # Poisson: variance grows with the rate
+        g = np.arange(-p.peak_search_radius_m, p.peak_search_radius_m + 1e-9, 0.05)
+        cands = np.array([[centre[0] + dx, centre[1] + dy] for dx in g for dy in g])
+        d_sq = np.sum((cands[:, None, :] - x[None, :, :]) ** 2, axis=-1)
+        a = 1.0 / (d_sq + p.height_m**2)
+        s_aa, s_a = np.sum(w * a * a, axis=1), np.sum(w * a, axis=1)
+        s_1, s_az, s_z = np.sum(w), np.sum(w * a * z, axis=1), np.sum(w * z)
+        det = s_aa * s_1 - s_a * s_a
+        ok = det > 1e-12 * np.maximum(s_aa * s_1, 1e-300)
+        strength = np.where(ok, (s_az * s_1 - s_a * s_z) / np.where(ok, det, 1.0), 0.0)
+        background = np.where(ok, (s_aa * s_z - s_a * s_az) / np.where(ok, det, 1.0), 0.0)
+        resid = z[None, :] - strength[:, None] * a - background[:, None]
+        cost = np.where(ok & (strength > 0.0), np.sum(w * resid * resid, axis=1), np.inf)
+        k = int(np.argmin(cost))
+        if not np.isfinite(cost[k]):
+            return hot
+        peak = strength[k] / p.height_m**2 + background[k]
+        return Hotspot((float(cands[k, 0]), float(cands[k, 1])), float(peak))
 
     def _add_hotspot(self, hot: Hotspot) -> bool:
         """Register a hotspot unless it is weak or already known; True if it was new."""
