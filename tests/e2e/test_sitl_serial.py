@@ -24,7 +24,8 @@ def test_apm25_over_the_serial_port_arms_climbs_shrugs_off_garbage_and_lands(
     st = Station(path, mavlink1=True, baud=115200)
     try:
         hb = st.wait_type("HEARTBEAT", lambda m: True, 10.0)
-        assert (hb.type, hb.autopilot, hb.base_mode) == (2, 3, 81)
+        assert (hb.type, hb.autopilot) == (2, 3)
+        assert hb.base_mode in (89, 81)
         st.request_streams(4)  # what fits a 115200-baud radio at 3x speed
         st.wait_type("RAW_IMU", lambda m: m.zacc < -900, 5.0)
         st.conn.write(b"\xfe\x21garbage" + bytes(range(255, -1, -1)) * 2)  # noise on the line
