@@ -59,7 +59,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.exit_code
     except LinkError as exc:
         print(f"quadgcs {args.command}: {exc}", file=sys.stderr)
-        return 1
+        return int(getattr(exc, "exit_code", 1))
     except KeyboardInterrupt:
         print(f"quadgcs {args.command}: interrupted", file=sys.stderr)
         return 130

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from typing import Any
 
 from rich.text import Text
 from textual.app import App, ComposeResult
@@ -73,8 +74,10 @@ class TeleopApp(App[None]):
         backend: TeleopBackend,
         *,
         clock: Callable[[], float] = time.monotonic,
+        redraw_timers: bool = True,
     ) -> None:
         super().__init__()
+        self.redraw_timers = redraw_timers  # False: draw once (screenshots of a fixed view)
         self.backend = backend
         self._clock = clock
         self.sticks = Sticks()
@@ -97,17 +100,20 @@ class TeleopApp(App[None]):
         yield log
         yield Footer()
 
-    def on_mount(self) -> None:
-        """Start the redraw and stick timers."""
+    def on_ready(self) -> None:
+        """Start the redraw and stick timers once every widget is on screen."""
         self.query_one("#link").border_title = "link"
         self.query_one("#vehicle").border_title = "vehicle"
         self.query_one("#altitude").border_title = "altitude"
         self.query_one("#messages").border_title = "messages"
+        self.redraw()
+        self.redraw_plots()
+        if not self.redraw_timers:
+            return
         self.set_interval(1.0 / REDRAW_HZ, self.redraw)
         self.set_interval(1.0 / PLOT_HZ, self.redraw_plots)
         if self.backend.live:
             self.set_interval(1.0 / STICK_HZ, self.send_sticks)
-        self.redraw()
 
     def on_unmount(self) -> None:
         """Let the backend release overrides and stop its thread."""
@@ -117,8 +123,8 @@ class TeleopApp(App[None]):
 
     def redraw(self) -> None:
         """Copy the latest view into the panels and append new messages."""
-        if self.frozen:
-            return
+        if self.frozen or not self.screen.query("#messages"):
+            return  # frozen by a test, or a timer firing while the screen comes or goes
         view = self.backend.view()
         for panel in self.query(".panel").results():
             panel.view = view  # type: ignore[attr-defined]
@@ -132,7 +138,7 @@ class TeleopApp(App[None]):
 
     def redraw_plots(self) -> None:
         """Redraw the two graphs (slower than the panels: plotext costs milliseconds)."""
-        if self.frozen:
+        if self.frozen or not self.screen.query(HeightPlot):
             return
         view: TeleopView = self.backend.view()
         self.query_one(HeightPlot).show(view)
@@ -217,7 +223,7 @@ class ReplayApp(TeleopApp):
     BINDINGS = REPLAY_BINDINGS
 
 
-def make_app(backend: TeleopBackend, **kwargs: Callable[[], float]) -> TeleopApp:
+def make_app(backend: TeleopBackend, **kwargs: Any) -> TeleopApp:
     """The live or replay app, as the backend is."""
     cls = LiveTeleopApp if backend.live else ReplayApp
     return cls(backend, **kwargs)

@@ -41,12 +41,18 @@ class ReplayBackend:
         self._messages: deque[tuple[float, str]] = deque(maxlen=200)
         self._next_plot_s = -math.inf
         self._t_s = 0.0
+        self._truth_m: float | None = None
         if start_playing:
             player.play()
 
     def _absorb(self, msg: ReplayMessage) -> None:
         self._latest[msg.topic] = msg.message
         self._t_s = msg.t_s
+        if msg.topic == topics.SIM_TRUTH:
+            # SIMSTATE carries no altitude (NaN, written as null); SIM_STATE does
+            down = _down_m(msg.message.get("pos_n"))
+            if down is not None:
+                self._truth_m = -down
         if msg.topic in (topics.EVENTS, topics.STATUS_TEXT):
             self._messages.append((msg.t_s, str(msg.message.get("text", ""))))
         elif msg.topic == topics.LINK_EVENT:
@@ -70,7 +76,7 @@ class ReplayBackend:
             self._absorb(msg)
         get = self._latest.get
         hb, att, est = get(topics.HEARTBEAT), get(topics.ATTITUDE), get(topics.ESTIMATE)
-        batt, sonar, truth = get(topics.BATTERY), get(topics.RANGEFINDER), get(topics.SIM_TRUTH)
+        batt, sonar = get(topics.BATTERY), get(topics.RANGEFINDER)
         ctrl, rc, loop = get(topics.ALT_CONTROLLER), get(topics.RC_OVERRIDE), get(topics.LOOP)
         state = "▶" if self.player.playing else "❚❚"
         if self.player.finished:
@@ -95,7 +101,7 @@ class ReplayBackend:
                 setpoint_m=ctrl.get("setpoint_m") if ctrl else None,
                 climb_mps=est.get("vel_mps") if est else None,
                 acc_up_mps2=est.get("acc_mps2") if est else None,
-                truth_m=-truth["pos_n"][2] if truth and _has_pos(truth) else None,
+                truth_m=self._truth_m,
                 hold_on=ctrl is not None,
                 throttle_us=int(rc["throttle_us"]) if rc else None,
             ),
@@ -131,6 +137,8 @@ class ReplayBackend:
         """Nothing to release: the recording is read-only."""
 
 
-def _has_pos(truth: dict[str, Any]) -> bool:
-    pos = truth.get("pos_n")
-    return isinstance(pos, list | tuple) and len(pos) == 3
+def _down_m(vec: Any) -> float | None:
+    """The z (down) part of a recorded vector: {"x","y","z"} as written, or a 3-list."""
+    z = vec.get("z") if isinstance(vec, dict) else (
+        vec[2] if isinstance(vec, list | tuple) and len(vec) == 3 else None)
+    return float(z) if isinstance(z, int | float) and math.isfinite(z) else None

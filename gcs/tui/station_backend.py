@@ -45,6 +45,7 @@ class StationBackend:
         self._last_sonar_t = -math.inf
         self._lock = threading.Lock()
         self._t0 = station.snapshot().t_s
+        self._truth_m: float | None = None
         self._target_m: float | None = None  # where the pilot has put the hold setpoint
         self._notes: tuple[tuple[float, str], ...] = (
             (0.0, f"recording to {recording}") if recording else (0.0, "not recording"),
@@ -61,6 +62,8 @@ class StationBackend:
             fresh_sonar = sonar
         self._baseline_alt = self._baseline.update(snap.imu, fresh_sonar, snap.attitude,
                                                    snap.t_s).alt_m
+        if snap.truth is not None and math.isfinite(snap.truth.pos_n[2]):
+            self._truth_m = -snap.truth.pos_n[2]  # SIMSTATE has no altitude; SIM_STATE has
         if snap.tick % HISTORY_EVERY_TICKS:
             return
         est = snap.estimate
@@ -114,7 +117,7 @@ class StationBackend:
                 setpoint_m=snap.alt_setpoint_m,
                 climb_mps=est.vel_mps if est else None,
                 acc_up_mps2=est.acc_mps2 if est else None,
-                truth_m=-snap.truth.pos_n[2] if snap.truth else None,
+                truth_m=self._truth_m,
                 hold_on=snap.mode in (ControlMode.ALT_HOLD, ControlMode.POSITION),
                 throttle_us=snap.command.throttle_us,
             ),

@@ -63,32 +63,9 @@ async def test_help_lists_every_binding() -> None:
         assert not app.screen.query("#help-body")
 
 
-def _freeze(app):  # type: ignore[no-untyped-def]
-    async def run_before(pilot) -> None:  # type: ignore[no-untyped-def]
-        app.redraw()
-        app.redraw_plots()
-        await pilot.pause()
-        app.frozen = True
-
-    return run_before
-
-
 def test_snapshot_main_80x24(snap_compare) -> None:  # type: ignore[no-untyped-def]
-    app = make_app(FixedBackend())
-    assert snap_compare(app, terminal_size=(80, 24), run_before=_freeze(app))
+    assert snap_compare(make_app(FixedBackend(), redraw_timers=False), terminal_size=(80, 24))
 
 
 def test_snapshot_main_large(snap_compare) -> None:  # type: ignore[no-untyped-def]
-    app = make_app(FixedBackend())
-    assert snap_compare(app, terminal_size=(160, 48), run_before=_freeze(app))
-
-
-def test_snapshot_help(snap_compare) -> None:  # type: ignore[no-untyped-def]
-    app = make_app(FixedBackend())
-
-    async def run_before(pilot) -> None:  # type: ignore[no-untyped-def]
-        await _freeze(app)(pilot)
-        await pilot.press("question_mark")
-        await pilot.pause()
-
-    assert snap_compare(app, terminal_size=(80, 24), run_before=run_before)
+    assert snap_compare(make_app(FixedBackend(), redraw_timers=False), terminal_size=(160, 48))
