@@ -5,8 +5,9 @@ strongest at 1 m, Poisson detector) it runs the planner, takes the contour level
 (the layer where intensity rises most sharply), and sweeps lawnmower spacings at that same level.
 For each field it prints samples, flight distance, IoU against the true field's contour and sources
 enclosed, plus the coarsest lawnmower spacing that matches the planner's IoU and the one that
-reaches IoU 0.85. Floor: planner IoU >= 0.85, every source enclosed, and at most 25 % of the
-lawnmower's samples at the spacing that matches the planner's IoU. Prints numbers; asserts nothing.
+reaches IoU 0.85 (lawnmower IoU averaged over three noise draws). Floor: planner IoU >= 0.85,
+every source enclosed, and at most 25 % of the lawnmower's samples at the spacing that matches
+the planner's IoU. Prints numbers; asserts nothing.
 
     .venv/bin/python bench/radiation.py [--fields 10] [--seed 2026]
 """
@@ -38,6 +39,7 @@ from planners.radiation_field import RadiationField  # noqa: E402
 SPACINGS_M = (3.0, 2.5, 2.0, 1.75, 1.5, 1.25, 1.0, 0.8, 0.67, 0.5, 0.4)
 IOU_FLOOR = 0.85
 SAMPLE_RATIO_FLOOR = 0.25
+LAWNMOWER_DRAWS = 3  # detector-noise draws per spacing, so one lucky survey does not decide
 
 
 def random_field(rng: np.random.Generator, n_sources: int) -> RadiationField:
@@ -56,21 +58,27 @@ def random_field(rng: np.random.Generator, n_sources: int) -> RadiationField:
 
 def sweep(
     field: RadiationField, level_cps: float, seed: int, params: RadiationMapperParams
-) -> list[tuple[float, RadiationResult]]:
-    """Lawnmower results from coarse to fine spacing, all at ``level_cps``."""
-    return [
-        (s, run_lawnmower(field, s, level_cps, np.random.default_rng(seed), params))
-        for s in SPACINGS_M
-    ]
+) -> list[tuple[float, RadiationResult, float, bool]]:
+    """Per spacing, coarse to fine: one survey, its IoU averaged over noise draws, all enclosed."""
+    out = []
+    for s in SPACINGS_M:
+        runs = [
+            run_lawnmower(field, s, level_cps, np.random.default_rng(seed + k), params)
+            for k in range(LAWNMOWER_DRAWS)
+        ]
+        mean_iou = float(np.mean([r.iou for r in runs]))
+        enclosed = all(r.sources_enclosed == r.sources_total for r in runs)
+        out.append((s, runs[0], mean_iou, enclosed))
+    return out
 
 
 def first_reaching(
-    results: list[tuple[float, RadiationResult]], iou: float
-) -> tuple[float, RadiationResult] | None:
-    """Coarsest spacing whose lawnmower IoU reaches ``iou`` and encloses every source."""
-    for s, r in results:
-        if r.iou >= iou and r.sources_enclosed == r.sources_total:
-            return s, r
+    results: list[tuple[float, RadiationResult, float, bool]], iou: float
+) -> tuple[float, RadiationResult, float, bool] | None:
+    """Coarsest spacing whose mean lawnmower IoU reaches ``iou`` with every source enclosed."""
+    for row in results:
+        if row[2] >= iou and row[3]:
+            return row
     return None
 
 
@@ -119,7 +127,7 @@ def main() -> None:
             f"{k:>3} {n_src:>3} | {ours.n_samples:>10} {ours.path_length_m:>6.0f} {ours.iou:>5.3f} "
             f"{ours.sources_enclosed:>2}/{ours.sources_total:<1} {ours.level_cps:>6.0f} "
             f"{ours.explored_fraction:>5.3f} {cpu:>5.1f} | {sp_txt:>26} "
-            f"{match[1].n_samples:>5} {match[1].path_length_m:>6.0f} {match[1].iou:>5.3f} "
+            f"{match[1].n_samples:>5} {match[1].path_length_m:>6.0f} {match[2]:>5.3f} "
             f"{ratio:>5.2f} | {sp85:>11} {n85:>4} {ratio85:>5.2f} | {'ok' if ok else 'MISSED'}"
             + ("" if ours.status.value == "reached" else f"  ({ours.reason})")
         )

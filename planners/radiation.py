@@ -28,11 +28,14 @@ PROSPECTING (extension)
     wasted a third of the samples.)
 EXECUTING (Section 10.4.2)
     The contour level is the layer where intensity rises most sharply: on a ladder of levels under
-    the weakest hotspot's peak, the one whose model contour has the steepest log-intensity gradient.
+    the weakest hotspot's peak, the one whose contour has the steepest log-intensity gradient, read
+    on the fitted inverse-square sources (the GP, smoothed over its 2-3 m lengthscale, put the
+    steepest layer too far out and merged neighbouring hotspots into one blob).
     Each hotspot's contour is followed with the cost of eq. 10.22 over five candidate positions,
     diagonal ones weighted up, until the path has wound once around the hotspot. The map is the
     GP's posterior mean on a grid and the contour its region at the level (contourpy), so separate
-    hotspots give a multi-polygon.
+    hotspots give a multi-polygon; parts holding neither a hotspot nor a reading at the level are
+    GP overshoot between sparse readings and are dropped.
 
 Departures from the text, and why
 ---------------------------------
@@ -412,8 +415,23 @@ class RadiationMapper:
         xs, ys = p.map_axes()
         mean, var = gp.predict_grid(xs, ys)
         level = self._level if self._level is not None else self._choose_level(gp)
-        region = region_above(xs, ys, mean, math.log(level))
+        region = self._supported(region_above(xs, ys, mean, math.log(level)), level)
         return MapEstimate(xs, ys, np.exp(mean), var, region, level)
+
+    def _supported(self, region: MultiPolygon, level: float) -> MultiPolygon:
+        """Keep the region's parts that hold a hotspot or a reading at or above the level.
+
+        Between sparse readings the GP can overshoot a steep log field and draw a small island
+        no reading supports; with hotspots known, such an island is an artefact, not a source.
+        """
+        if not self._hotspots:
+            return region
+        pos = np.array(self._pos)
+        strong = pos[np.array(self._cps) >= level]
+        evidence = [shapely.Point(h.pos_n) for h in self._hotspots]
+        evidence += [shapely.Point(q) for q in strong]
+        keep = [g for g in region.geoms if any(g.covers(e) for e in evidence)]
+        return MultiPolygon(keep)
 
     # ----- coroutine --------------------------------------------------------------------------
 
@@ -536,6 +554,13 @@ class RadiationMapper:
         away = here - centre
         away = away / np.linalg.norm(away) if np.linalg.norm(away) > 1e-9 else np.array([1.0, 0.0])
         radius = self._crossing_radius(gp, centre, away, log_level)
+        model = self._source_model()
+        if model is not None:
+            # The fitted sources place the contour better than the GP before it is traced.
+            r = np.arange(0.05, 2.0 * p.max_sample_distance_m, 0.05)
+            ray = centre[None, :] + r[:, None] * away[None, :]
+            below = np.nonzero(model.intensity(ray[:, 0], ray[:, 1]) < level)[0]
+            radius = float(r[below[0]]) if below.size else radius
         start = p.clip(centre + radius * away)
         step_m = min(max(p.trace_step_fraction * radius, p.min_trace_step_m), p.max_trace_step_m)
         pos, cps = yield _Ask(start, Phase.EXECUTING, f"joining the {level:.0f} cps contour")
@@ -773,14 +798,29 @@ class RadiationMapper:
         radii = np.arange(0.05, 2.0 * p.max_sample_distance_m, 0.05)
         centres = np.array([h.pos_n for h in self._hotspots])
         pts = centres[:, None, None, :] + radii[None, None, :, None] * dirs[None, :, None, :]
-        mean = gp.predict_mean(pts.reshape(-1, 2)).reshape(pts.shape[:3])
+        model = self._source_model()
+        if model is None:
+            log_i, grad_log_i = gp.predict_mean, gp.gradient
+        else:
+            # The fitted sources: unlike the GP, not smoothed over a 2-3 m lengthscale, so the
+            # steepest layer sits where the inverse-square law puts it.
+            def log_i(q: np.ndarray) -> np.ndarray:
+                return np.log(model.intensity(q[:, 0], q[:, 1]))
+
+            def grad_log_i(q: np.ndarray) -> np.ndarray:
+                h = np.array([[1e-3, 0.0], [0.0, 1e-3]])
+                return np.column_stack(
+                    [(log_i(q + h[k]) - log_i(q - h[k])) / 2e-3 for k in range(2)]
+                )
+
+        mean = log_i(pts.reshape(-1, 2)).reshape(pts.shape[:3])
         layers: list[Layer] = []
         for level in levels:
             below = mean < math.log(level)
             crossed = below.any(axis=2)
             first = np.argmax(below, axis=2)
             where = pts[crossed, first[crossed]] if crossed.any() else np.zeros((0, 2))
-            grads = np.linalg.norm(gp.gradient(where), axis=1) if where.size else np.zeros(0)
+            grads = np.linalg.norm(grad_log_i(where), axis=1) if where.size else np.zeros(0)
             layers.append(Layer(level, float(np.mean(grads)) if grads.size else 0.0))
         self._layers = tuple(layers)
         return max(layers, key=lambda lay: lay.log_gradient_per_m).level_cps
