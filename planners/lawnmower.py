@@ -72,6 +72,7 @@ def run_lawnmower(
         status=Status.REACHED,
         reason=f"lawnmower survey of {path.shape[0]} samples at {xs[1] - xs[0]:.2f} m",
         samples=np.column_stack([path, cps]),
+        sample_phases=(),
         path_n=path,
         path_length_m=path_length_m(path),
         explored_fraction=1.0,

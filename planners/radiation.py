@@ -257,6 +257,7 @@ class RadiationResult:
     status: Status
     reason: str
     samples: np.ndarray  # (n, 3): x_m, y_m, counts_per_s
+    sample_phases: tuple[Phase, ...]  # what each reading was taken for
     path_n: np.ndarray  # (m, 2) positions flown, in order
     path_length_m: float
     explored_fraction: float  # eq. 10.2
@@ -322,6 +323,7 @@ class RadiationMapper:
         self._hyper_n = 0
         self._start_cps = 1.0
         self._rejected_readings = 0
+        self._sample_phases: list[Phase] = []
         self._gen: Generator[_Ask, tuple[np.ndarray, float], str] | None = None
         self._last: Decision | None = None
         self._status: Status | None = None
@@ -358,6 +360,11 @@ class RadiationMapper:
     def level_cps(self) -> float | None:
         """The contour level being (or that was) followed."""
         return self._level
+
+    @property
+    def sample_phases(self) -> tuple[Phase, ...]:
+        """The phase each reading was taken for, in order."""
+        return tuple(self._sample_phases)
 
     @property
     def samples(self) -> np.ndarray:
@@ -397,6 +404,7 @@ class RadiationMapper:
             if self._gen is None:
                 self._gen = self._plan()
                 next(self._gen)
+            self._sample_phases.append(self._last.phase if self._last else Phase.LEARNING)
             ask = self._gen.send((pos, float(counts_per_s)))
         except StopIteration as stop:
             self._finish(Status.REACHED if self._hotspots else Status.FAILED, str(stop.value))
@@ -900,6 +908,7 @@ def run_radiation(
         status=status,
         reason=mapper.reason,
         samples=mapper.samples,
+        sample_phases=mapper.sample_phases,
         path_n=path_arr,
         path_length_m=path_length_m(path_arr),
         explored_fraction=float(explored / p.floor_area_m2),

@@ -193,3 +193,15 @@ def test_parameters_load_from_a_toml_table() -> None:
                 {"gp_lengthscales_m": 2.0}, {"dwell_s": True}):  # fmt: skip
         with pytest.raises(ValueError):
             RadiationMapperParams.from_toml(bad)
+
+
+def test_executing_samples_follow_the_chosen_layer(three_source_run) -> None:
+    r = three_source_run
+    assert len(r.sample_phases) == r.n_samples
+    on_trace = np.array([ph is Phase.EXECUTING for ph in r.sample_phases])
+    assert on_trace.sum() >= 3 * 6  # each hotspot's loop took several steps
+    xy = r.samples[on_trace, :2]
+    true_log_ratio = np.log(THREE.intensity(xy[:, 0], xy[:, 1]) / r.level_cps)
+    # Zig-zagging across the contour, but close to it: within a factor 2 almost always.
+    assert np.mean(np.abs(true_log_ratio) < math.log(2.0)) > 0.8
+    assert abs(np.median(true_log_ratio)) < 0.3
