@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -60,8 +61,7 @@ def run_mission(spec: MissionSpec, options: RunOptions,
     mw = mission_world(spec)
     setup = planner_setup(spec, mw.world.room.min_n[:2], mw.world.room.max_n[:2])
     if options.seed is not None:
-        setup = type(setup)(**{**{f: getattr(setup, f) for f in setup.__dataclass_fields__},
-                               "seed": options.seed})
+        setup = dataclasses.replace(setup, seed=options.seed)
     if not options.kinematic:
         from gcs.mission.executor import run_on_vehicles
 

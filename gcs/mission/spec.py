@@ -6,6 +6,18 @@ was wrong and what is expected, e.g.
 
 Positions in mission files are written as a user thinks of a room: `[x, y, alt]` with x north,
 y east and altitude positive up (metres); they are turned into local NED here, once.
+
+    name = "epbha_table"
+    world = "../worlds/table_room.toml"    # relative to the mission file
+    [[vehicles]]  sysid = 1, start = [x, y, alt]   (start: kinematic runs only; default the
+                                                    world's start points)
+    [flight]      takeoff_alt_m, land, max_duration_s, profile ("apm25" | "copter4"),
+                  speedup (SITL and station clock), position_tolerance_m, settle_s,
+                  step_timeout_s (when a planner's set position counts as reached)
+    [planner]     kind = "epbha" | "flocking" | "radiation", then the planner's parameters by
+                  their field names, plus max_steps, seed, noise_sigma_m, max_samples,
+                  floor_margin_m (see gcs.mission.planner_params)
+    [goal]        position = [x, y, alt], individual = [[x, y, alt], ...], tolerance_m
 """
 
 from __future__ import annotations

@@ -1,0 +1,44 @@
+"""Radiation mapping on the bundled SITL, a short smoke flight: live detector readings recorded."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from gcs.cli import main
+from gcs.mission import recording as topics
+from gcs.mission.world import load_world
+from logs import open_recording
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(240)
+def test_a_short_mapping_flight_samples_the_sitl_field(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = (ROOT / "missions" / "radiation_3src.toml").read_text()
+    text = text.replace("max_samples = 400", "max_samples = 6")
+    text = text.replace('"../worlds/', f'"{ROOT}/worlds/')
+    mission = tmp_path / "smoke.toml"
+    mission.write_text(text)
+    plot = tmp_path / "smoke.png"
+    code = main(["mission", "run", str(mission), "--speedup", "2", "--seed", "4", "--json",
+                 "-o", str(tmp_path), "--plot", str(plot)])
+    d = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    # six samples cannot map three sources: the mission says so and exits 3
+    assert code == 3
+    assert d["status"] == "failed" and "budget of 6" in d["reason"]
+    assert d["samples"] == 6 and d["collisions"] == 0 and d["mode"] == "vehicle"
+    rec = open_recording(d["recording"])
+    samples = [m for _, _, m in rec.messages([topics.SAMPLE_RADIATION])]
+    assert len(samples) == 6
+    field = load_world(ROOT / "worlds" / "radiation_3src.toml").radiation_field(height_m=1.0)
+    for s in samples:  # the detector's Poisson readings agree with the world's sources
+        expected = field.intensity_at((s["x"], s["y"]))
+        assert abs(s["counts_per_s"] - expected) < 6.0 * expected**0.5 + 10.0
+    assert rec.topic_info[topics.MAP_MEAN].schema_name == "foxglove.Grid"
+    assert rec.counts["/vehicle/radiation"] > 6
+    assert plot.read_bytes()[:4] == b"\x89PNG"

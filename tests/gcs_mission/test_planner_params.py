@@ -1,0 +1,47 @@
+"""The [planner] table into the planners' parameter dataclasses."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from gcs.errors import UsageError
+from gcs.mission.planner_params import planner_setup
+from gcs.mission.spec import load_mission
+from planners.flocking import FollowerPolicy
+
+
+def spec_with(tmp_path: Path, planner: str) -> object:
+    f = tmp_path / "m.toml"
+    f.write_text(f"[planner]\n{planner}\n[goal]\nposition = [1.0, 0.0, 1.0]\n")
+    return load_mission(f)
+
+
+def test_flocking_keys_reach_nested_formation_and_enums(tmp_path: Path) -> None:
+    spec = spec_with(tmp_path, 'kind = "flocking"\npolicy = "self_avoid"\nside_m = 0.9\n'
+                               'cost_weights = [4, 2, 6]\nmax_steps = 50\nseed = 9')
+    setup = planner_setup(spec)  # type: ignore[arg-type]
+    assert setup.params.policy is FollowerPolicy.SELF_AVOID
+    assert setup.params.formation.side_m == 0.9
+    assert setup.params.cost_weights == (4.0, 2.0, 6.0)
+    assert (setup.max_steps, setup.seed) == (50, 9)
+
+
+def test_radiation_area_defaults_to_the_room_inside_the_margin(tmp_path: Path) -> None:
+    spec = spec_with(tmp_path, 'kind = "radiation"\nfloor_margin_m = 1.0\nx_max_m = 5.0')
+    setup = planner_setup(spec, (-10.0, -10.0), (10.0, 10.0))  # type: ignore[arg-type]
+    p = setup.params
+    assert (p.x_min_m, p.y_min_m, p.x_max_m, p.y_max_m) == (-9.0, -9.0, 5.0, 9.0)
+
+
+@pytest.mark.parametrize(("line", "needle"), [
+    ('policy = "telepathy"', "planner.policy: expected one of self_avoid, heads_up"),
+    ("side_m = 0.3", "planner: "),
+    ("max_steps = 1.5", "planner.max_steps: expected int"),
+])
+def test_bad_flocking_values(tmp_path: Path, line: str, needle: str) -> None:
+    spec = spec_with(tmp_path, f'kind = "flocking"\n{line}')
+    with pytest.raises(UsageError) as err:
+        planner_setup(spec)  # type: ignore[arg-type]
+    assert needle in str(err.value) and "\n" not in str(err.value)
