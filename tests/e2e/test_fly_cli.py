@@ -48,7 +48,7 @@ def test_fly_json_records_the_flight(tmp_path: Path) -> None:
         (["fly", "--world", "no/such/world.toml"], 2, "no such file"),
         (["fly", "--speedup", "0"], 2, "--speedup"),
         (["fly", "--connect", "tcp:127.0.0.1:1", "--no-record"], 1, "127.0.0.1:1"),
-        (["fly", "--connect", "bogus::url", "--no-record"], 1, "bogus"),
+        (["fly", "--connect", "bogus::url", "--no-record"], 2, "bogus"),
     ],
 )
 def test_bad_input_ends_in_one_line(argv: list[str], code: int, needle: str) -> None:
