@@ -40,7 +40,7 @@ from firmware_link.records import (
     StatusText,
     TelemetryRecord,
 )
-from gcs import topics
+from gcs import params_json, topics
 from gcs.altitude_controller import AltControlOutput, AltitudeController
 from gcs.clock import Clock, MonotonicClock
 from gcs.config import StationConfig
@@ -148,6 +148,37 @@ class LoopSample:
     overrun: bool
 
 
+@dataclass(frozen=True, slots=True)
+class StationSetup:
+    """/gcs/setup payload, once at start: what a rerun needs to rebuild the control stack."""
+
+    config_json: str  # StationConfig as gcs.params_json text (non-finite floats kept)
+    curve_json: str  # ThrottleCurve as gcs.params_json text
+    hover_throttle: float  # the altitude controller's starting hover throttle
+
+
+@dataclass(frozen=True, slots=True)
+class TickInputs:
+    """/gcs/tick payload: what one tick consumed and decided, so a rerun can replay it exactly.
+
+    The `*_n` counts are how many records of each type this tick ingested: the next ones, in
+    recorded order, on their topics."""
+
+    tick: int
+    t_s: float
+    dt_s: float
+    imu_n: int
+    rangefinder_n: int
+    attitude_n: int
+    mocap_n: int
+    link_lost: bool
+    mode: ControlMode
+    engage_count: int  # altitude-controller engagements so far (bumpless take-overs)
+    alt_target_m: float | None
+    alt_rate_mps: float | None
+    sticks_throttle_us: int
+
+
 @dataclass
 class _State:
     mode: ControlMode = ControlMode.MANUAL
@@ -163,6 +194,7 @@ class _State:
     engaged: bool = False
     was_lost: bool = False
     mocap_ok: bool = False
+    engage_count: int = 0
 
 
 class Station:
@@ -202,6 +234,10 @@ class Station:
         self._record_listeners: list[Callable[[TelemetryRecord], None]] = []
         self._empty_stats = self.loop.stats()
         self._snapshot = self._make_snapshot(self.clock.now_s(), -1)
+        if recorder is not None:
+            recorder.put(topics.SETUP, self.clock.now_s(), StationSetup(
+                params_json.dumps(self.config), params_json.dumps(self.curve),
+                self.alt_ctrl.hover_throttle))
 
     # ------------------------------------------------------------------ lifecycle
     def start(self) -> None:
@@ -415,7 +451,7 @@ class Station:
         if not lost:
             s.command = self._command(t_s, dt_s, est)
         self.link.rc_override(s.command)
-        self._record_tick(t_s, k, est)
+        self._record_tick(t_s, k, est, dt_s, records)
         snap = self._make_snapshot(t_s, k)
         with self._lock:
             self._snapshot = snap
@@ -451,14 +487,7 @@ class Station:
             elif isinstance(r, StatusText):
                 self._event(r.t_s, EventLevel.INFO if r.severity > 4 else EventLevel.WARNING,
                             f"vehicle: {r.text}")
-        imu = None
-        if imus:
-            # average the samples of this tick: less vibration noise, same information
-            n = len(imus)
-            acc = tuple(sum(i.acc_b[a] for i in imus) / n for a in range(3))
-            last = imus[-1]
-            imu = Imu(last.t_s, last.sysid, acc, last.gyro_b, last.source, last.time_usec)
-        return imu, sonars, attitude
+        return average_imu(imus), sonars, attitude
 
     def _command(self, t_s: float, dt_s: float, est: AltEstimate) -> RcCommand:
         s = self._s
@@ -478,6 +507,7 @@ class Station:
             self.alt_ctrl.engage(est, None if on_ground else s.command.throttle_us, roll, pitch)
             s.alt_setpoint_m = est.alt_m
             s.engaged = True
+            s.engage_count += 1
         target = s.alt_target_m if s.alt_target_m is not None else s.alt_setpoint_m
         assert s.alt_setpoint_m is not None and target is not None
         if s.alt_rate_mps is None:
@@ -504,11 +534,21 @@ class Station:
         return RcCommand(roll_us=roll_us, pitch_us=pitch_us, throttle_us=s.alt.throttle_us,
                          yaw_us=yaw_us)
 
-    def _record_tick(self, t_s: float, k: int, est: AltEstimate) -> None:
+    def _record_tick(self, t_s: float, k: int, est: AltEstimate, dt_s: float,
+                     records: list[TelemetryRecord]) -> None:
         rec = self.recorder
         if rec is None:
             return
         s = self._s
+        rec.put(topics.TICK, t_s, TickInputs(
+            tick=k, t_s=t_s, dt_s=dt_s,
+            imu_n=sum(isinstance(r, Imu) for r in records),
+            rangefinder_n=sum(isinstance(r, Rangefinder) for r in records),
+            attitude_n=sum(isinstance(r, Attitude) for r in records),
+            mocap_n=sum(isinstance(r, MocapPose) for r in records),
+            link_lost=s.was_lost, mode=s.mode, engage_count=s.engage_count,
+            alt_target_m=s.alt_target_m, alt_rate_mps=s.alt_rate_mps,
+            sticks_throttle_us=s.sticks.throttle_us))
         rec.put(topics.ESTIMATE, t_s, est)
         if s.alt is not None:
             rec.put(topics.ALT_CONTROLLER, t_s, s.alt)
@@ -559,6 +599,16 @@ class Station:
             link_stats=self.link.stats,
             events=tuple(self._events),
         )
+
+
+def average_imu(imus: list[Imu]) -> Imu | None:
+    """One tick's IMU samples averaged: less vibration noise, same information (None if none)."""
+    if not imus:
+        return None
+    n = len(imus)
+    acc = tuple(sum(i.acc_b[a] for i in imus) / n for a in range(3))
+    last = imus[-1]
+    return Imu(last.t_s, last.sysid, acc, last.gyro_b, last.source, last.time_usec)
 
 
 def _clamp_us(v: int) -> int:

@@ -28,6 +28,8 @@ POSITION_CONTROLLER = "/gcs/position_controller"
 RC_OVERRIDE = "/gcs/rc_override"
 LOOP = "/gcs/loop"
 EVENTS = "/gcs/events"
+TICK = "/gcs/tick"  # what each tick consumed and decided (for an exact rerun)
+SETUP = "/gcs/setup"  # the station's configuration and throttle curve, once at start
 
 RECORD_TOPICS: dict[type, str] = {
     r.Heartbeat: HEARTBEAT,
