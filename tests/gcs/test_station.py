@@ -16,6 +16,7 @@ from firmware_link.records import (
     Imu,
     LinkEvent,
     LinkEventKind,
+    MocapPose,
     Rangefinder,
     RcCommand,
     SimTruth,
@@ -24,6 +25,7 @@ from firmware_link.records import (
 from gcs import topics
 from gcs.clock import MonotonicClock, SimClock
 from gcs.estimation import GRAVITY_MPS2
+from gcs.position_controller import PositionSetpoint
 from gcs.station import ControlMode, EventLevel, Station
 from gcs.thrust_curve import ThrottleCurve
 
@@ -217,3 +219,34 @@ def test_link_events_become_station_events() -> None:
     board.poll = poll_with_event  # type: ignore[method-assign]
     run_s(st, 0.05)
     assert any(e.text.startswith("link lost") for e in st.snapshot().events)
+
+
+class FakeMocap:
+    """Poses of the fake board's vehicle at a fixed spot, yawed 90° (facing east)."""
+
+    def __init__(self, clock: SimClock, north_m: float, east_m: float) -> None:
+        self.clock = clock
+        self.pos = (north_m, east_m)
+
+    def poll(self) -> list[Any]:
+        q = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))
+        return [MocapPose(self.clock.now_s(), 1, (*self.pos, -1.0), q, 0)]
+
+
+def test_position_mode_leans_toward_the_setpoint_in_the_heading_frame() -> None:
+    clock = SimClock(50.0)
+    board = FakeBoard(clock, 0.5)
+    st = Station(board, clock=clock, curve=board.curve, mocap=FakeMocap(clock, 0.0, 0.0))
+    st.request_arm()
+    st.loop.run(max_ticks=8)
+    st.set_position_setpoint(PositionSetpoint(1.0, 0.0, math.pi / 2))
+    st.loop.run(max_ticks=8)
+    snap = st.snapshot()
+    assert snap.mode is ControlMode.POSITION and snap.position is not None
+    # facing east with the target to the north: roll left (low roll stick), no pitch
+    assert board.overrides[-1].roll_us < 1500
+    assert board.overrides[-1].pitch_us == 1500
+    st.mocap = None  # the mocap system goes silent: hold level, say so
+    st.loop.run(max_ticks=20)
+    assert board.overrides[-1].roll_us == 1500
+    assert any("motion capture lost" in e.text for e in st.snapshot().events)
