@@ -1,19 +1,25 @@
 """Baseline: a boustrophedon (lawnmower) survey with the contour drawn from its samples.
 
 Rows run along x and step along y; the samples form a regular lattice covering the floor edge to
-edge, so the lattice spacing is at most ``spacing_m``. The map is the log of the readings on that
-lattice; contourpy interpolates it linearly along the cell edges at the same level the planner
-chose, which is a fair match for a field whose logarithm is smooth.
+edge, so the lattice spacing is at most ``spacing_m``. Two ways to draw the contour, at the same
+level the planner chose:
+
+* ``Interpolation.LOG_LINEAR``: the log of the readings on the lattice, which contourpy
+  interpolates linearly along the cell edges;
+* ``Interpolation.GP``: the same Gaussian process on log-intensity the planner uses, fitted to the
+  survey and evaluated on the planner's map grid (a much stronger baseline at coarse spacings).
 """
 
 from __future__ import annotations
 
 import math
+from enum import Enum
 
 import numpy as np
 import shapely
 
 from planners.contour import region_above
+from planners.gp import GpHyper, fit_by_grid_search
 from planners.radiation import (
     RadiationMapperParams,
     RadiationResult,
@@ -22,6 +28,16 @@ from planners.radiation import (
 )
 from planners.radiation_field import RadiationField
 from planners.tsp import path_length_m
+
+
+class Interpolation(Enum):
+    """How the survey's readings become a map."""
+
+    LOG_LINEAR = "log_linear"
+    GP = "gp"
+
+
+LAWNMOWER_LENGTHSCALES_M = (0.5, 0.75, 1.0, 1.5, 2.0)  # finer than the planner's: dense lattice
 
 
 def lawnmower_axes(
@@ -54,6 +70,7 @@ def run_lawnmower(
     level_cps: float,
     rng: np.random.Generator,
     params: RadiationMapperParams | None = None,
+    interpolation: Interpolation = Interpolation.LOG_LINEAR,
 ) -> RadiationResult:
     """Survey the whole floor at ``spacing_m`` and contour the samples at ``level_cps``."""
     p = params or RadiationMapperParams()
@@ -66,11 +83,27 @@ def run_lawnmower(
     for q, c in zip(path, cps, strict=True):
         grid[int(np.argmin(np.abs(ys - q[1]))), int(np.argmin(np.abs(xs - q[0])))] = c
     log_grid = np.log(np.maximum(grid, 0.5 / p.dwell_s))
-    region = region_above(xs, ys, log_grid, math.log(level_cps))
+    map_xs, map_ys, mean_cps, log_var = xs, ys, grid, np.zeros_like(grid)
+    if interpolation is Interpolation.GP:
+        counts = np.maximum(cps * p.dwell_s, 0.5)
+        y = np.log(counts / p.dwell_s)
+        gp = fit_by_grid_search(
+            path, y, GpHyper(), LAWNMOWER_LENGTHSCALES_M, 1.0 / counts + p.gp_nugget,
+            float(np.quantile(y, 0.2)),
+        )  # fmt: skip
+        map_xs, map_ys = p.map_axes()
+        mean, log_var = gp.predict_grid(map_xs, map_ys)
+        mean_cps = np.exp(mean)
+        region = region_above(map_xs, map_ys, mean, math.log(level_cps))
+    else:
+        region = region_above(xs, ys, log_grid, math.log(level_cps))
     ev = evaluate_region(region, field_, level_cps, p)
     return RadiationResult(
         status=Status.REACHED,
-        reason=f"lawnmower survey of {path.shape[0]} samples at {xs[1] - xs[0]:.2f} m",
+        reason=(
+            f"lawnmower survey of {path.shape[0]} samples at {xs[1] - xs[0]:.2f} m, "
+            f"{interpolation.value} map"
+        ),
         samples=np.column_stack([path, cps]),
         sample_phases=(),
         path_n=path,
@@ -87,8 +120,8 @@ def run_lawnmower(
         contour_polygons=ev.polygons,
         region=shapely.MultiPolygon(list(region.geoms)),
         reference_region=ev.reference,
-        map_xs_m=xs,
-        map_ys_m=ys,
-        mean_cps=grid,
-        log_var=np.zeros_like(grid),
+        map_xs_m=map_xs,
+        map_ys_m=map_ys,
+        mean_cps=mean_cps,
+        log_var=log_var,
     )

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from planners.lawnmower import lawnmower_path, run_lawnmower
+from planners.lawnmower import Interpolation, lawnmower_path, run_lawnmower
 from planners.radiation import (
     Phase,
     RadiationMapper,
@@ -205,3 +205,13 @@ def test_executing_samples_follow_the_chosen_layer(three_source_run) -> None:
     # Zig-zagging across the contour, but close to it: within a factor 2 almost always.
     assert np.mean(np.abs(true_log_ratio) < math.log(2.0)) > 0.8
     assert abs(np.median(true_log_ratio)) < 0.3
+
+
+def test_gp_mapped_lawnmower_beats_log_linear_at_coarse_spacing() -> None:
+    level = 0.4 * ONE.intensity_at((3.0, 2.0))
+    linear = run_lawnmower(ONE, 2.0, level, np.random.default_rng(1))
+    gp = run_lawnmower(ONE, 2.0, level, np.random.default_rng(1), None, Interpolation.GP)
+    assert gp.n_samples == linear.n_samples == 121
+    assert gp.iou > linear.iou
+    assert gp.mean_cps.shape == (101, 101) and np.all(gp.log_var >= 0.0)
+    assert "gp map" in gp.reason
