@@ -60,6 +60,11 @@ class ThrottleCurve:
         )
 
     @property
+    def _mid(self) -> float:
+        # ArduCopter 3.2.1 constrains THR_MID to 300..700 before using it
+        return min(max(self.thr_mid, 300.0), 700.0)
+
+    @property
     def mid_output(self) -> float:
         """Motor throttle at mid-stick (the firmware's own hover guess), 0..1."""
         return self.output(0.5 * (self.rc_min_us + self.rc_max_us))
@@ -73,12 +78,13 @@ class ThrottleCurve:
         s = self._stick(pwm_us)
         if self.kind is CurveKind.APM25:
             c = s * 1000.0
+            mid = self._mid
             if c < 500.0:
-                out = self.thr_min + (c - self.thr_min) * (self.thr_mid - self.thr_min) / (
+                out = self.thr_min + (c - self.thr_min) * (mid - self.thr_min) / (
                     500.0 - self.thr_min
                 )
             else:
-                out = self.thr_mid + (c - 500.0) * (1000.0 - self.thr_mid) / 500.0
+                out = mid + (c - 500.0) * (1000.0 - mid) / 500.0
             return min(max(out / 1000.0, 0.0), 1.0)
         e = self._expo()
         return s * (1.0 - e) + e * s**3
@@ -93,12 +99,11 @@ class ThrottleCurve:
         span = self.rc_max_us - self.rc_min_us
         if self.kind is CurveKind.APM25:
             o = out * 1000.0
-            if o < self.thr_mid:
-                c = self.thr_min + (o - self.thr_min) * (500.0 - self.thr_min) / (
-                    self.thr_mid - self.thr_min
-                )
+            mid, lo = self._mid, self.thr_min
+            if o < mid:
+                c = lo + (o - lo) * (500.0 - lo) / (mid - lo)
             else:
-                c = 500.0 + (o - self.thr_mid) * 500.0 / (1000.0 - self.thr_mid)
+                c = 500.0 + (o - mid) * 500.0 / (1000.0 - mid)
             return self.rc_min_us + min(max(c / 1000.0, 0.0), 1.0) * span
         # the expo is monotonic on [0, 1] for e in [-0.5, 1]: bisection is exact enough in 40 steps
         a, b = 0.0, 1.0
