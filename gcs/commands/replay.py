@@ -1,12 +1,14 @@
 """`quadgcs replay FILE`: play a recorded flight on its timeline, one status line per second.
 
-Headless playback lives in `run_replay`; re-running a flight through the station's estimator and
-controller (`--rerun`) belongs in its own function beside it.
+Headless playback lives in `run_replay`; `--rerun` (`run_rerun`) feeds the recorded sensor data
+through fresh estimator and altitude-controller instances, optionally with other parameters
+(`--gains`), and reports how their outputs differ from the recorded ones (gcs/rerun.py).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -26,11 +28,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--headless", action="store_true",
                         help="print summary lines instead of opening the screens (the default "
                              "when output is not a terminal)")
+    parser.add_argument("--rerun", action="store_true",
+                        help="re-run the estimator and altitude controller on the recorded "
+                             "sensor data and report how their outputs differ from the recording")
+    parser.add_argument("--gains", action="append", default=[], metavar="SPEC",
+                        help="with --rerun: parameter changes, 'alt.kp=1.2,alt.ki=0.3' (dotted "
+                             "station-config keys; alt. = altitude.gains., est. = estimator., "
+                             "pos. = position.) or a station-config TOML file; repeatable")
+    parser.add_argument("--json", action="store_true", help="with --rerun: one JSON object")
     parser.set_defaults(func=run_replay)
 
 
 def run_replay(args: argparse.Namespace) -> int:
-    """Play the recording and print its summary lines."""
+    """Play the recording and print its summary lines (or rerun it with `--rerun`)."""
+    if args.rerun:
+        return run_rerun(args)
+    if args.gains or args.json:
+        raise UsageError("--gains and --json go with --rerun")
     try:
         recording = open_recording(args.file)
         player = Player(recording, speed=args.speed)
@@ -49,4 +63,32 @@ def run_screens(player: Player, path: Path, metadata: dict[str, object]) -> int:
     from gcs.tui.replay_backend import ReplayBackend
 
     make_app(ReplayBackend(player, name=path.name, metadata=dict(metadata))).run()
+    return 0
+
+
+def run_rerun(args: argparse.Namespace) -> int:
+    """Re-run the flight's estimator and controller; print the per-signal differences."""
+    from gcs.rerun import (
+        apply_overrides,
+        changed_parameters,
+        compare,
+        format_report,
+        load_flight,
+        parse_gains,
+        rerun,
+    )
+
+    try:
+        recording = open_recording(args.file)
+    except RecordingError as exc:
+        raise UsageError(str(exc)) from exc
+    flight = load_flight(recording)
+    config = flight.config
+    for spec in args.gains:
+        config = apply_overrides(config, parse_gains(spec))
+    report = compare(flight, rerun(flight, config), changed_parameters(flight.config, config))
+    if args.json:
+        print(json.dumps(report.to_jsonable()))
+    else:
+        print("\n".join(format_report(report, args.file.name)))
     return 0
