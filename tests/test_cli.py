@@ -23,3 +23,10 @@ def test_console_script_runs_as_module() -> None:
 
 def test_parser_builds() -> None:
     assert build_parser().prog == "quadgcs"
+
+
+def test_bench_lists_programs_and_rejects_unknown(capsys) -> None:
+    assert main(["bench"]) == 0
+    assert "alt_hold" in capsys.readouterr().out
+    assert main(["bench", "no_such_bench"]) == 2
+    assert "unknown bench 'no_such_bench'" in capsys.readouterr().err
