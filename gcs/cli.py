@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 
@@ -60,6 +61,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except LinkError as exc:
         print(f"quadgcs {args.command}: {exc}", file=sys.stderr)
         return int(getattr(exc, "exit_code", 1))
+    except BrokenPipeError:
+        # the reader (e.g. `| head`) went away: not an error, and nothing more to say
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
     except KeyboardInterrupt:
         print(f"quadgcs {args.command}: interrupted", file=sys.stderr)
         return 130

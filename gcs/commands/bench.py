@@ -47,7 +47,8 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"unknown bench {unknown[0]!r}; expected one of {', '.join(names)}")
     for name in chosen:
         print(f"== bench/{name}.py", flush=True)
-        code = subprocess.call([sys.executable, str(BENCH_DIR / f"{name}.py")])
+        # -P: the script's own folder must not shadow packages (bench/planners.py vs planners)
+        code = subprocess.call([sys.executable, "-P", str(BENCH_DIR / f"{name}.py")])
         if code != 0:
             raise RuntimeFault(f"bench/{name}.py exited with code {code}")
     return 0
