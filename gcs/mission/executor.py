@@ -386,8 +386,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
                 outcome = _flock(f, setup, hover)
             else:
                 outcome = _radiation(f, setup, hover, mw)
-            if spec.land:
-                f.land()
+            f.land()  # whatever `flight.land` says: closing the session releases the sticks
         except BaseException:
             for c in crafts.values():
                 c.station.kill()
