@@ -122,11 +122,14 @@ class FlockParams:
     sidestep_overshoot_steps: int = 2
     cost_weights: Vec3 = (4.0, 2.0, 6.0)  # Definition 7's A, B (even), and one for altitude
     common_wait_steps: int = 150  # how long the root waits at the common goal for its team
+    make_way_steps: int = 2  # a vehicle that stepped aside keeps clear this long
     overfly_after_steps: int = 4  # blocked this long by teammates, a vehicle flies over them
     overfly_height_m: float = 0.7  # above its goal altitude; more than the safe distance
     policy: FollowerPolicy = FollowerPolicy.HEADS_UP
     leader_avoider: LeaderAvoider = LeaderAvoider.EPBHA
-    epbha: EpbhaParams = field(default_factory=EpbhaParams)
+    # The leader keeps the followers' 0.3 m stop distance, not EPBHA's 0.25 m: a corner 0.14 m
+    # off its path sits between the cone's rays and is seen only as the side face behind it.
+    epbha: EpbhaParams = field(default_factory=lambda: EpbhaParams(keep_off_m=0.3))
     latency_steps: int = 0
     formation: FormationParams = field(default_factory=FormationParams)
 
@@ -222,6 +225,7 @@ class _State:
     individual: bool = False  # flying its individual goal (Algorithm 9.3.4)
     arrived_final: bool = False
     make_way_from: list[Vec3] = field(default_factory=list)  # where higher-priority ones wanted
+    keep_clear: list[tuple[Vec3, int]] = field(default_factory=list)  # (point, until step)
     guard_blocked: int = 0  # consecutive steps the guard refused this vehicle's best move
     overfly: bool = False  # climbing over teammates that block the way to its goal
 
@@ -263,6 +267,7 @@ class FlockPlanner:
         self._states = [_State() for _ in range(self.n)]
         self._wanted: dict[int, Vec3] = {}  # guard-refused moves this step, by tree index
         self._start_pos: list[Vec3] = []
+        self._step_index = 0
         self._epbha: Epbha | None = None
         self._epbha_failed = False
         g = mission.common_goal_n
@@ -316,6 +321,7 @@ class FlockPlanner:
         reserved: list[Vec3] = list(pos)  # type: ignore[arg-type]
         self._wanted = {}
         self._start_pos = list(reserved)
+        self._step_index = step_index
         modes: dict[int, VehicleMode] = {}
         held: list[int] = []
         sent = 0
@@ -395,6 +401,9 @@ class FlockPlanner:
         """
         safe = self.params.formation.safe_distance_m
         p0 = self._start_pos[k]
+        for w, until in self._states[k].keep_clear:
+            if until >= self._step_index and _dist(sp, w) < min(safe, _dist(p0, w)):
+                return False
         for j, q1 in enumerate(reserved):
             if j == k:
                 continue
@@ -415,7 +424,12 @@ class FlockPlanner:
     def _note_blocking(self, k: int, mode: VehicleMode, reading: ProximityReading) -> None:
         """Count steps the guard refused k's best move; long enough, k flies over the jam."""
         st = self._states[k]
-        st.guard_blocked = st.guard_blocked + 1 if k in self._wanted else 0
+        # Refusals add up until the vehicle gets somewhere: in a jam the blocker may step aside
+        # and back again, so single free steps do not clear the count.
+        if mode in (VehicleMode.WAITING, VehicleMode.ARRIVED, VehicleMode.TRAIL):
+            st.guard_blocked = 0
+        elif k in self._wanted:
+            st.guard_blocked += 1
         # Only in the open: near walls (a queue at a door) climbing would scramble the queue.
         free_to_climb = mode in (VehicleMode.FORMATION, VehicleMode.INDIVIDUAL) and not (
             reading.active(self.params.formation.sensing_range_m)
@@ -448,6 +462,9 @@ class FlockPlanner:
         wanted = st.make_way_from
         st.make_way_from = []
         s = self.params.step_m
+        # Stay out of the way a while, or the two would swap places back and forth for ever.
+        until = self._step_index + self.params.make_way_steps
+        st.keep_clear = [(w, until) for w in wanted]
 
         def margin(q: Vec3) -> float:
             return min(_dist(q, w) for w in wanted)
@@ -623,6 +640,17 @@ class FlockPlanner:
         prm = self.params
         if st.goal_n is None:
             return p, VehicleMode.WAITING
+        par = self.formation.parent(k)
+        assert par is not None
+        leader_queues = self._states[par].in_trail
+        if (
+            not st.in_trail
+            and leader_queues
+            and st.trail
+            and prm.policy is FollowerPolicy.HEADS_UP
+        ):
+            # Heads-up: the leader is squeezing along its own leader's path; follow it in.
+            self._enter_trail(k, p)
         if st.in_trail:
             return self._walk_trail(k, p, reading, reserved)
         goal = self._overfly_target(k, p, st.goal_n)
@@ -658,6 +686,7 @@ class FlockPlanner:
         if (
             st.clear_steps >= prm.rejoin_clear_steps
             and st.goal_n is not None
+            and not self._states[self.formation.parent(k) or 0].in_trail
             and self._way_is_clear(k, p, st.goal_n)
         ):
             st.in_trail = False
@@ -714,7 +743,12 @@ class FlockPlanner:
         self._wait_at_common += 1
         for k in range(1, self.n):
             st = self._states[k]
-            if not st.individual and self._settled(k, pos[k]):
+            par = self.formation.parent(k)
+            assert par is not None
+            # A slot is final only once its leader has settled in its own final slot; before
+            # that it may still lie on the near side of a wall the leader has yet to pass.
+            leader_final = par == 0 or self._states[par].individual
+            if not st.individual and leader_final and self._settled(k, pos[k]):
                 st.individual = True
                 st.avoid_dir = None
         team_settled = all(self._states[k].individual for k in range(1, self.n))
