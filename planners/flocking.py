@@ -16,15 +16,17 @@ position and its six IR readings:
 * a follower whose way is blocked either avoids on its own sensors (``SELF_AVOID``) or, with the
   leader's heads-up (``HEADS_UP``), walks the trail of positions its leader sent — a path known
   to be free — in its own altitude layer, so that through a narrow opening the team passes one
-  by one at different heights and may queue closer than on one level (layered formation, §9.4);
+  by one at different heights and may queue closer than on one level (layered formation, §9.4).
+  A follower whose leader is queueing on a trail joins the queue behind it at once instead of
+  pressing on towards a slot beyond the wall;
 * once the root holds the common goal, every vehicle flies to its individual goal (Algorithm
   9.3.4), or to its final slot around the common goal when it has none.
 
-A safety guard runs last for every vehicle, in tree order: a set position is accepted only if it
-stays ``safe_distance_m`` (3-D) from every set position already granted this step and from the
-current position of every vehicle not yet planned; otherwise the vehicle holds, which is always
-safe by the same rule. So the team never closes below the safe distance when vehicles reach their
-set positions, whatever the planner above the guard decides.
+A safety guard runs last for every vehicle, in tree order: a move is accepted only if it stays
+``safe_distance_m`` (3-D) all along the step from every teammate — those planned earlier this
+step moving straight to their granted set positions, the others standing still; otherwise the
+vehicle holds, which is always safe by the same rule. So the team never closes below the safe
+distance while vehicles fly straight to their set positions, whatever the planner above decides.
 
 Departures from the text: the thesis's ``θ`` in "degree/100" and ``P(f1) = 1 − θ`` are not used
 (a probability from an angle in those units is not well defined); the sidestep rule classifies
