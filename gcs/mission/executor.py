@@ -350,7 +350,7 @@ def _radiation(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3],
         k += 1
     path_xy = np.array([(q[0], q[1]) for q in path])
     metrics, products = finish_radiation(mapper, field_, path_xy, f.rec, f.clock.now_s())
-    ok, why = is_reached(metrics)
+    ok, why = is_reached(metrics, setup.min_iou)
     if f.over_budget() and not mapper.done:
         ok, why = False, f"mission time {spec.max_duration_s:g} s spent"
     return _Outcome(MissionStatus.REACHED if ok else MissionStatus.FAILED, why, k, path,

@@ -250,7 +250,7 @@ def run_radiation_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerS
         k += 1
     path_xy = np.array(path)
     metrics, products = finish_radiation(mapper, field, path_xy, rec, t0 + t)
-    ok, why = is_reached(metrics)
+    ok, why = is_reached(metrics, setup.min_iou)
     outside = sum(not mw.world.in_room((float(q[0]), float(q[1]), -spec.takeoff_alt_m))
                   for q in path_xy)
     report = MissionReport(

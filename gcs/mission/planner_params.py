@@ -27,6 +27,7 @@ MISSION_KEYS: dict[str, type] = {
     "noise_sigma_m": float,  # IR noise of the kinematic world (the SITL's own is in its world)
     "max_samples": int,  # radiation: sample budget
     "floor_margin_m": float,  # radiation: keep the mapping area this far inside the room walls
+    "min_iou": float,  # radiation: the found contour must overlap the true one this much
 }
 
 
@@ -40,6 +41,7 @@ class PlannerSetup:
     noise_sigma_m: float
     max_samples: int
     floor_margin_m: float
+    min_iou: float
 
 
 def _convert(value: Any, hint: Any, where: str) -> Any:
@@ -125,4 +127,5 @@ def planner_setup(spec: MissionSpec, room_min_n: tuple[float, float] | None = No
         noise_sigma_m=float(mission.get("noise_sigma_m", 0.01)),
         max_samples=int(mission.get("max_samples", 400)),
         floor_margin_m=margin,
+        min_iou=float(mission.get("min_iou", 0.5)),
     )

@@ -60,13 +60,16 @@ def finish_radiation(mapper: RadiationMapper, field: RadiationField, path_xy: np
     return metrics, products
 
 
-def is_reached(metrics: dict[str, Any]) -> tuple[bool, str]:
-    """The mapping goal: the mapper finished and its contour encloses every source."""
+def is_reached(metrics: dict[str, Any], min_iou: float) -> tuple[bool, str]:
+    """The mapping goal: the mapper finished, its contour encloses every source and overlaps
+    the true field's contour at the same level by at least `min_iou` (intersection over
+    union)."""
     if metrics["mapper_status"] != "reached":
         return False, metrics["mapper_reason"] or "mapping did not finish"
     if metrics["sources_enclosed"] < metrics["sources_total"]:
         return False, (f"contour encloses {metrics['sources_enclosed']} of "
                        f"{metrics['sources_total']} sources")
-    if not math.isfinite(metrics["iou"]):
-        return False, "no contour"
+    if not math.isfinite(metrics["iou"]) or metrics["iou"] < min_iou:
+        return False, (f"contour overlaps the true one by IoU {metrics['iou']:.2f}, "
+                       f"below {min_iou:g}")
     return True, metrics["mapper_reason"]
