@@ -2,8 +2,10 @@
 
 Prints one row per (scene, team size, planner): time to goal of the root leader and of the
 followers (mean / last), formation error, minimum separation, collisions, messages, throughput
-through the door, and how the run ended. In the door scene a third row flies the triangular flock
-on one level (``n_layers=1``), to show what the altitude layers change. Run from the repository
+through the door, and how the run ended. Rows: ``triangular`` (followers use the leader's
+heads-up trail), ``tri-self`` (followers avoid on their own sensors only), ``tri-flat`` (door
+scene: heads-up on one level, ``n_layers=1``, to show what the altitude layers change) and
+``reynolds``. Run from the repository
 root (``bench/planners.py`` would shadow the package if run as a script):
 ``.venv/bin/python -m bench.flocking [sizes...]``.
 """
@@ -24,7 +26,7 @@ from planners.flock_sim import (
     run_flock,
     triangular_factory,
 )
-from planners.flocking import FlockParams
+from planners.flocking import FlockParams, FollowerPolicy
 
 MAX_STEPS = 1200
 SEED = 7
@@ -56,7 +58,10 @@ def main(argv: list[str]) -> None:
     )
     for n in sizes:
         for scene in all_scenes():
-            planners: list[tuple[str, PlannerFactory]] = [("triangular", triangular_factory())]
+            planners: list[tuple[str, PlannerFactory]] = [
+                ("triangular", triangular_factory()),
+                ("tri-self", triangular_factory(FlockParams(policy=FollowerPolicy.SELF_AVOID))),
+            ]
             if scene.gate is not None:
                 planners.append(("tri-flat", triangular_factory(FlockParams(n_layers=1))))
             planners.append(("reynolds", reynolds_factory()))
