@@ -6,8 +6,9 @@ Flights (real time, over TCP, apm25 unless told otherwise):
    compute and process CPU per tick. Floors: jitter p99 <= 1 ms and 0 overruns.
 2. Short holds (`--compare-s`, default 30) with each estimator: the thesis's eq. 6.1 dead
    reckoning, the third-order complementary filter and the Kalman filter, each with a step.
-3. The same short hold flown by the autopilot's onboard ALT_HOLD (the station only keeps the
-   sticks centred), scored against the altitude at which it was engaged.
+3. The same short hold flown by the autopilot's onboard ALT_HOLD (the station keeps the
+   sticks centred, or holds position from motion capture), scored against 1.0 m.
+With motion capture (the default world has it) the station also holds the take-off spot.
 
 Prints numbers; asserts nothing.
 
@@ -26,7 +27,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from firmware_link import VehicleLink
+from firmware_link import MocapLink, VehicleLink
 from firmware_link.records import FlightMode
 from gcs.config import EstimatorKind, StationConfig
 from gcs.errors import QuadgcsError
@@ -41,14 +42,20 @@ def session(profile: str, config: StationConfig, seed: int) -> Iterator[Station]
     """A bundled SITL, a link to it and a started station; all stopped on exit."""
     with contextlib.ExitStack() as stack:
         sitl = SitlProcess(SitlOptions(profile=profile, seed=seed))
-        url = sitl.start().url(1)
+        endpoints = sitl.start()
+        url = endpoints.url(1)
         stack.callback(sitl.stop)
+        mocap = None
+        if endpoints.mocap is not None:
+            mocap = MocapLink.open(endpoints.mocap)
+            stack.callback(mocap.close)
         link = VehicleLink.open(url)
         stack.callback(link.close)
         link.bring_up(40.0)
         names = ("MOT_THST_HOVER",) if profile == "copter4" else ("THR_MIN", "THR_MID")
         params = {n: link.get_param(n) for n in names}
-        st = Station(link, config=config, curve=ThrottleCurve.for_dialect(link.dialect, params))
+        st = Station(link, config=config, curve=ThrottleCurve.for_dialect(link.dialect, params),
+                     mocap=mocap)
         st.start()
         stack.callback(st.stop)
         yield st

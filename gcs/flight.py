@@ -18,6 +18,7 @@ import numpy as np
 
 from firmware_link.records import FlightMode
 from gcs.errors import RuntimeFault
+from gcs.position_controller import PositionSetpoint, yaw_from_quat
 from gcs.station import ControlMode, Station, StationSnapshot
 
 POLL_S = 0.1
@@ -205,6 +206,12 @@ class FlightRunner:
         self.phase = Phase.TAKEOFF
         self._target = p.alt_m
         st.alt_hold(True, p.alt_m, rate_mps=p.climb_mps)
+        pose = st.snapshot(loop_stats=False).mocap
+        if pose is not None:
+            # with motion capture, hold the take-off spot and heading: without it the vehicle
+            # drifts on its attitude noise and, in a room, ends up against a wall
+            n, e, _ = pose.pos_n
+            st.set_position_setpoint(PositionSetpoint(n, e, yaw_from_quat(pose.q_nb)))
         climb_s = p.alt_m / p.climb_mps
         self._wait("take-off to the hold altitude",
                    lambda s: s.estimate is not None and abs(s.estimate.alt_m - p.alt_m) < 0.1
