@@ -120,7 +120,10 @@ What a ground station sees:
                   DISTANCE_SENSOR (orientations 0,2,4,6,24,25; 51 cm = nothing in range)
                   at 10 Hz, NAMED_VALUE_FLOAT "RAD_CPS" at 5 Hz when the world has sources.
   motion capture  sysid 200, compid = tracked vehicle's sysid, ATT_POS_MOCAP at 100 Hz.
-  ground truth    SIMSTATE and SIM_STATE (EXTRA1 stream), for evaluation only.
+  ground truth    SIM_STATE (EXTRA1 stream, at the ATTITUDE rate), for evaluation only;
+                  capped at 10 Hz on the serial port so it leaves the 115200-baud budget
+                  to the control streams. No SIMSTATE (it has no altitude).
+  serial port     MAVLink 1 frames (apm25) carry base payloads only, as a real v1 sender.
   FS_GCS_ENABLE   1: land when the GCS is silent for 5 s; 3 (this SITL): hold altitude
                   until the battery failsafe, then land.
 """

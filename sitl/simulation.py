@@ -79,9 +79,11 @@ class VehicleRuntime:
         self.mocap_out: list[MocapFrame] = []
         self._refresh_cache()
 
-    def add_channel(self, port: int, name: str) -> Channel:
-        """A new link for this vehicle (SR<port>_* rates)."""
-        return self.link.add_channel(port, name)
+    def add_channel(
+        self, port: int, name: str, truth_max_rate_hz: float = math.inf
+    ) -> Channel:
+        """A new link for this vehicle (SR<port>_* rates, ground truth capped)."""
+        return self.link.add_channel(port, name, truth_max_rate_hz)
 
     def tick(self, dt_s: float) -> None:
         """Sensors → autopilot → physics → telemetry, for one loop period."""

@@ -89,10 +89,17 @@ class RadiationSource:
 
 @dataclass(frozen=True, slots=True)
 class GeoOrigin:
-    """Where NED (0, 0, 0) is on Earth (the floor at the origin)."""
+    """Where NED (0, 0, 0) is on Earth (the floor at the origin).
 
-    lat_deg: float = 36.4446  # JAIST, Nomi, Ishikawa: the thesis's lab
-    lon_deg: float = 136.5927
+    The default is 0° N 0° E, not the thesis's lab (JAIST, 36.4446° N 136.5927° E): the vehicle
+    has no GPS, so the location is only a label, but ground truth leaves the SITL as SIM_STATE,
+    whose MAVLink 1 payload has latitude/longitude as float32 degrees (the int32 fields are
+    MAVLink 2 extensions). A float32 resolves 0.4 m × 1.4 m at JAIST and well under a millimetre
+    within a few kilometres of 0° N 0° E, so truth positions stay exact on both profiles.
+    """
+
+    lat_deg: float = 0.0
+    lon_deg: float = 0.0
     alt_amsl_m: float = 60.0
 
 

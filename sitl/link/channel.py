@@ -6,6 +6,7 @@ periodic telemetry is, oldest first, when the transport can't keep up (a slow ra
 
 from __future__ import annotations
 
+import math
 import time
 from collections import deque
 from collections.abc import Callable
@@ -29,6 +30,7 @@ class Channel:
         port: int,
         name: str,
         wall_clock: Callable[[], float] = time.time,
+        truth_max_rate_hz: float = math.inf,
     ) -> None:
         self.view = view
         self.name = name
@@ -36,7 +38,7 @@ class Channel:
         self.codec = MavCodec(view.sysid, 1, mav1)
         self.companion_codec = MavCodec(view.sysid, COMPANION_COMPID, mav1)
         self._wall_clock = wall_clock
-        self.streams = StreamSchedule(view.params, port)
+        self.streams = StreamSchedule(view.params, port, truth_max_rate_hz)
         self._replies: deque[bytes] = deque()
         self._telemetry: deque[bytes] = deque()
         self._telemetry_bytes = 0

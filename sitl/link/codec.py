@@ -3,16 +3,24 @@
 Uses pymavlink's generated ardupilotmega dialect (MAVLink 2 module, which also reads and writes
 MAVLink 1 frames). A MAVLink-1-only codec (Copter 3.2.1 on the APM 2.5) sends v1 frames and
 drops v2 frames it receives, counting them as bad, as that firmware's parser does.
+
+MAVLink 1 has no extension fields, so a v1 frame carries only a message's base payload (the C
+library's `min_length`): DISTANCE_SENSOR is 14 bytes, not 39. pymavlink's `force_mavlink1` packs
+the extensions anyway; `encode` cuts them off and recomputes the checksum (CRC_EXTRA covers only
+base fields, so the frame is exactly what a MAVLink 1 sender puts on the wire). A receiver
+zero-fills the missing extensions.
 """
 
 from __future__ import annotations
 
 import hashlib
+import struct
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pymavlink.dialects.v10 import ardupilotmega as mavlink_v1
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 MAVLINK2_MAGIC = 0xFD
@@ -20,6 +28,27 @@ SIGNING_KEY_BYTES = 32
 SIGNING_EPOCH_UNIX_S = 1420070400  # MAVLink signing epoch, 2015-01-01
 # Messages Copter 4.x accepts unsigned on a signed link (radio modems inject RADIO_STATUS).
 UNSIGNED_ALLOWED_IDS = frozenset({mavlink.MAVLINK_MSG_ID_RADIO_STATUS})
+
+
+V1_HEADER_BYTES = 6  # STX, len, seq, sysid, compid, msgid
+V1_CRC_BYTES = 2
+# The v1.0 dialect is generated without extensions: its payload size is the base length.
+V1_BASE_PAYLOAD_BYTES: dict[int, int] = {
+    msg_id: cls.unpacker.size for msg_id, cls in mavlink_v1.mavlink_map.items()
+}
+
+
+def mavlink1_base_frame(frame: bytes) -> bytes:
+    """A MAVLink 1 frame cut to its message's base payload, with the checksum recomputed."""
+    msg_id = frame[5]
+    base = V1_BASE_PAYLOAD_BYTES.get(msg_id)
+    if base is None or frame[1] <= base:
+        return frame
+    out = bytearray(frame[: V1_HEADER_BYTES + base])
+    out[1] = base
+    crc = mavlink.x25crc(out[1:])
+    crc.accumulate(struct.pack("B", mavlink_v1.mavlink_map[msg_id].crc_extra))
+    return bytes(out) + struct.pack("<H", crc.crc)
 
 
 class SigningKeyError(ValueError):
@@ -95,10 +124,11 @@ class MavCodec:
         return self.mav.signing.secret_key is not None
 
     def encode(self, msg: Any) -> bytes:
-        """Pack one message (sequence and signature applied)."""
+        """Pack one message (sequence and signature applied; MAVLink 1: base payload only)."""
         self.mav.send(msg, force_mavlink1=self.mavlink1_only)
         self.stats.tx += 1
-        return self._sink.frames.pop()
+        frame = self._sink.frames.pop()
+        return mavlink1_base_frame(frame) if self.mavlink1_only else frame
 
     def decode(self, data: bytes) -> list[Any]:
         """Parse bytes; return whole good messages, counting everything dropped."""

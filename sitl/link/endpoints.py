@@ -5,7 +5,9 @@
 - UDP: sends to the configured HOST:PORT and answers whoever last sent a datagram (udpclient).
 - Serial: a pseudo-terminal pair; the slave's path is what a GCS opens (through pyserial). Output
   is throttled to the baud rate (115200 baud ≈ 11.5 kB/s) and telemetry that doesn't fit is
-  dropped oldest-first, as a radio modem's buffer would.
+  dropped oldest-first, as a radio modem's buffer would. Its channel caps ground truth
+  (SIM_STATE) at `server.SERIAL_TRUTH_MAX_RATE_HZ` so evaluation data never crowds out control
+  telemetry.
 All are non-blocking and serviced from one loop (`sitl.link.server`).
 """
 

@@ -8,6 +8,7 @@ PARAM_VALUE after a PARAM_SET and STATUSTEXT go to every link, as ArduPilot broa
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -40,7 +41,6 @@ _BUILDERS: dict[str, Callable[[VehicleView], Any]] = {
     "SERVO_OUTPUT_RAW": tm.servo_output_raw,
     "RANGEFINDER": tm.rangefinder,
     "DISTANCE_SENSOR": tm.distance_sensor_down,
-    "SIMSTATE": tm.simstate,
     "SIM_STATE": tm.sim_state,
 }
 
@@ -60,9 +60,11 @@ class VehicleLink:
         self.companion = companion or Companion()
         self._next_heartbeat_s = 0.0
 
-    def add_channel(self, port: int, name: str) -> Channel:
-        """Create a link using stream-rate parameters SR<port>_*."""
-        ch = Channel(self.view, port, name)
+    def add_channel(
+        self, port: int, name: str, truth_max_rate_hz: float = math.inf
+    ) -> Channel:
+        """Create a link using stream-rate parameters SR<port>_* (ground truth capped)."""
+        ch = Channel(self.view, port, name, truth_max_rate_hz=truth_max_rate_hz)
         self.channels.append(ch)
         return ch
 

@@ -25,6 +25,9 @@ from sitl.simulation import Simulation
 TCP_BASE_PORT = 5760
 PORT_STRIDE = 10  # vehicle i listens on base + 10·(i − 1), as ArduPilot's --instance
 MAX_LAG_S = 1.0
+# Ground truth on the 115200-baud port: a 92-byte SIM_STATE at the 40 Hz ATTITUDE rate would
+# take a third of the link; 10 Hz (8 % of it) is plenty to score a flight. TCP/UDP: full rate.
+SERIAL_TRUTH_MAX_RATE_HZ = 10.0
 
 
 @dataclass(frozen=True)
@@ -35,6 +38,7 @@ class EndpointPlan:
     udp: tuple[str, int] | None = None
     serial: bool = False
     mocap_port: int | None = None  # None = no mocap server
+    serial_truth_max_rate_hz: float = SERIAL_TRUTH_MAX_RATE_HZ
 
 
 class SitlServer:
@@ -61,7 +65,7 @@ class SitlServer:
             ch = rt.add_channel(0, "tcp")
             self.endpoints.append((rt.sysid, TcpServerEndpoint(ch, rt.link.receive, port)))
             if plan.serial:
-                ch = rt.add_channel(1, "serial")
+                ch = rt.add_channel(1, "serial", plan.serial_truth_max_rate_hz)
                 self.endpoints.append((rt.sysid, PtySerialEndpoint(ch, rt.link.receive)))
             if plan.udp is not None:
                 host, uport = plan.udp

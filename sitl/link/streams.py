@@ -2,11 +2,17 @@
 
 Nothing streams until a GCS asks (only HEARTBEAT and STATUSTEXT, as the real firmware).
 Group rates are stored in the channel's SRn_* parameters, as ArduPilot does, and capped at 50 Hz.
+
+Ground truth (SIM_STATE) rides in EXTRA1 beside ATTITUDE, as ArduPilot's SITL sends it. It is
+evaluation data, not firmware behaviour, so one message per profile carries it (SIM_STATE: it has
+the altitude that SIMSTATE lacks) and a link may cap it (`truth_max_rate_hz`, used on the
+115200-baud serial port) so it never crowds out the control streams a real APM 2.5 would send.
 """
 
 from __future__ import annotations
 
 import enum
+import math
 
 from sitl.autopilot import ParamStore, Profile
 
@@ -37,6 +43,7 @@ SR_SUFFIX: dict[Stream, str] = {
 }
 
 MAX_RATE_HZ = 50.0
+TRUTH_MESSAGE = "SIM_STATE"
 
 
 def group_messages(profile: Profile) -> dict[Stream, tuple[str, ...]]:
@@ -50,7 +57,7 @@ def group_messages(profile: Profile) -> dict[Stream, tuple[str, ...]]:
         Stream.RC_CHANNELS: ("SERVO_OUTPUT_RAW", "RC_CHANNELS_RAW" if apm else "RC_CHANNELS"),
         Stream.RAW_CONTROLLER: (),
         Stream.POSITION: (),
-        Stream.EXTRA1: ("ATTITUDE", "SIMSTATE", "SIM_STATE"),
+        Stream.EXTRA1: ("ATTITUDE", TRUTH_MESSAGE),
         Stream.EXTRA2: ("VFR_HUD",),
         Stream.EXTRA3: ("RANGEFINDER",) if apm else ("DISTANCE_SENSOR",),
     }
@@ -59,9 +66,14 @@ def group_messages(profile: Profile) -> dict[Stream, tuple[str, ...]]:
 class StreamSchedule:
     """Decides which telemetry messages are due on one link at a given time."""
 
-    def __init__(self, params: ParamStore, port: int) -> None:
+    def __init__(
+        self, params: ParamStore, port: int, truth_max_rate_hz: float = math.inf
+    ) -> None:
+        if not truth_max_rate_hz > 0.0:
+            raise ValueError(f"truth_max_rate_hz {truth_max_rate_hz} must be > 0")
         self.params = params
         self.port = port
+        self.truth_min_period_s = 1.0 / truth_max_rate_hz
         self._groups = group_messages(params.profile)
         self._msg_group = {m: g for g, ms in self._groups.items() for m in ms}
         self._override_s: dict[str, float | None] = {}  # None = disabled by SET_MESSAGE_INTERVAL
@@ -104,9 +116,13 @@ class StreamSchedule:
     def interval_s(self, name: str) -> float | None:
         """Current period of a message, None when not streaming."""
         if name in self._override_s:
-            return self._override_s[name]
-        rate = self.params.get(self._param_of[name])
-        return 1.0 / rate if rate > 0.0 else None
+            period = self._override_s[name]
+        else:
+            rate = self.params.get(self._param_of[name])
+            period = 1.0 / rate if rate > 0.0 else None
+        if period is not None and name == TRUTH_MESSAGE:
+            period = max(period, self.truth_min_period_s)
+        return period
 
     def _refresh_periods(self) -> None:
         """Recompute every message's period when a parameter or interval changed."""

@@ -5,9 +5,9 @@ mrad/s, body FRD: this is what ArduPilot's send_raw_imu writes for every IMU inc
 2.5's MPU-6000/6050 (the chip's own LSB counts never leave the firmware), so a station converts
 with a_mss = xacc · 9.80665e-3 and w_rads = xgyro · 1e-3. (The thesis's eq. 5.1 converts the
 chip's LSB/g counts on its own Arduino; behind ArduPilot that conversion has already happened.)
-Ground truth goes out as SIMSTATE (attitude, lat/lng) and SIM_STATE (adds altitude and NED
-velocity). SIM_STATE is sent on apm25 too: it is a MAVLink 1 message and without it no truth
-altitude would leave the SITL in that profile.
+Ground truth goes out as SIM_STATE only (attitude quaternion and Euler angles, body acceleration
+and rates, lat/lng, altitude, NED velocity), on both profiles: it is a MAVLink 1 message, and
+SIMSTATE would add nothing but bytes (it has no altitude). See `sitl.link.streams` for its rate.
 """
 
 from __future__ import annotations
@@ -205,16 +205,6 @@ def _latlon(v: VehicleView) -> tuple[float, float, float]:
     lat = o.lat_deg + math.degrees(n / EARTH_RADIUS_M)
     lon = o.lon_deg + math.degrees(e / (EARTH_RADIUS_M * math.cos(math.radians(o.lat_deg))))
     return lat, lon, o.alt_amsl_m - d
-
-
-def simstate(v: VehicleView) -> Any:
-    """SIMSTATE: ground truth attitude, body acceleration and rates, position (lat/lng)."""
-    c = v.cache
-    lat, lon, _ = _latlon(v)
-    r, p, y = c.truth_euler
-    return mavlink.MAVLink_simstate_message(
-        r, p, y, *c.truth_acc_b, *c.truth_omega_b, int(lat * 1e7), int(lon * 1e7)
-    )
 
 
 def sim_state(v: VehicleView) -> Any:

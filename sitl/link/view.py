@@ -33,8 +33,8 @@ class SensorCache:
 class GeoOrigin:
     """Where local NED (0, 0, 0) is on the earth, for SIMSTATE/SIM_STATE lat/lon."""
 
-    lat_deg: float = 36.4437
-    lon_deg: float = 136.5927
+    lat_deg: float = 0.0  # see sitl.world.GeoOrigin for why
+    lon_deg: float = 0.0
     alt_amsl_m: float = 60.0
 
 

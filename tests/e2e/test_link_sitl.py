@@ -129,13 +129,12 @@ def test_link_flies_both_dialects(sitl: Sitl, transport: str) -> None:
         assert report.confirmed
         if transport == "serial":
             assert report.plan.total_bytes_per_s <= 0.8 * 11520.0
-            # Never choke the serial link: if the vehicle sends more than the plan knows
-            # (companion board, extra group members), bring-up stops at the rate that fits.
-            assert report.steps[-1].rx_bytes_per_s <= 0.9 * 11520.0
-            assert report.reached or report.limit_hz is not None
-        else:
-            assert report.reached
-            assert report.achieved("ATTITUDE") == pytest.approx(40.0, rel=0.1)
+            # 40 Hz control telemetry, the companion board and capped ground truth all fit
+            # 80 % of 115200 baud (MAVLink 1 base payloads on apm25, unsigned copter4).
+            assert report.steps[-1].rx_bytes_per_s <= 0.8 * 11520.0
+            assert report.limit_hz is None
+        assert report.reached
+        assert report.achieved("ATTITUDE") == pytest.approx(40.0, rel=0.1)
         records = link.poll()
         imu = [r for r in records if isinstance(r, Imu)]
         assert imu and abs(sum(a * a for a in imu[-1].acc_b) ** 0.5 - 9.81) < 1.0
