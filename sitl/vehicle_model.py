@@ -100,6 +100,7 @@ class SimVehicle:
         c0.used_mah = float(battery_used_mah)
         c0.voltage_v = terminal_voltage_v(self.params, c0.used_mah, c0.current_a)
         self.t_s = 0.0
+        self._f_b_mean: Vec3 | None = None  # specific force averaged over the last step
         s = world.sensors
         r_imu, r_sonar, r_baro, r_prox, r_rad, r_mocap = rng.spawn(6)
         self._imu = ImuModel(s.imu, r_imu, noise)
@@ -137,8 +138,11 @@ class SimVehicle:
         t0 = self.t_s
         sonar, mocap = self._sonar, self._mocap
         advance = physics.advance
+        sfx = sfy = sfz = 0.0
         for i in range(1, n + 1):
             advance(c, u0, u1, u2, u3, prm, geom, h)
+            fx, fy, fz = rotate_n_to_b((c.qw, c.qx, c.qy, c.qz), (c.ax, c.ay, c.az - GRAVITY_MPS2))
+            sfx, sfy, sfz = sfx + fx, sfy + fy, sfz + fz
             t = t0 + i * h
             if t >= sonar.next_ping_t_s:
                 rng_m, surface = self._sonar_range()
@@ -146,6 +150,7 @@ class SimVehicle:
             if mocap is not None and t >= mocap.next_capture_t_s - 1e-9:
                 mocap.capture(t, (c.x, c.y, c.z), (c.qw, c.qx, c.qy, c.qz))
         self.t_s = t0 + dt_s
+        self._f_b_mean = (sfx / n, sfy / n, sfz / n)
 
     def set_pose(
         self,
@@ -169,6 +174,7 @@ class SimVehicle:
         c.on_ground = c.z >= rest_z
         if c.on_ground:
             c.z = rest_z
+        self._f_b_mean = None
 
     # --- truth and power ----------------------------------------------------------------
 
@@ -229,10 +235,17 @@ class SimVehicle:
         return (c.m0 + c.m1 + c.m2 + c.m3) / (4.0 * derived(self.params).omega_max_ref_radps)
 
     def imu(self) -> ImuSample:
-        """MPU-6050 reading now: specific force (a − g) and body rates, in FRD."""
+        """MPU-6050 reading now: specific force (a − g) averaged over the last step, body rates.
+
+        The average over the step (the autopilot's loop period) stands for the MPU-6050's
+        low-pass filter and ArduPilot's averaging of the samples between two loops: a floor or
+        ceiling impact inside any sub-step reaches the accelerometer, not only one in the last.
+        Before the first step (or after a teleport) it is the instantaneous value.
+        """
         c = self._core
-        q = (c.qw, c.qx, c.qy, c.qz)
-        f_b = rotate_n_to_b(q, (c.ax, c.ay, c.az - GRAVITY_MPS2))
+        f_b = self._f_b_mean
+        if f_b is None:
+            f_b = rotate_n_to_b((c.qw, c.qx, c.qy, c.qz), (c.ax, c.ay, c.az - GRAVITY_MPS2))
         return self._imu.sample(self.t_s, f_b, (c.p, c.q, c.r), self._rotor_speed_frac())
 
     def _sonar_range(self) -> tuple[float | None, FloorMaterial]:
