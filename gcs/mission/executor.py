@@ -201,10 +201,8 @@ class _Flight:
         for v, target in targets.items():
             if settled[v]:
                 out[v] = target
-            else:
-                m = self.crafts[v].position_n()
-                est = self.crafts[v].snapshot().estimate
-                out[v] = (m[0], m[1], -est.alt_m if est is not None else m[2])
+            else:  # where it is, in the room's frame (the sonar estimate is over furniture)
+                out[v] = self.crafts[v].position_n()
         return out
 
 
