@@ -25,6 +25,7 @@ from planners.proximity import Facing, ProximityReading
 PROXIMITY_STALE_S = 0.5  # a facing not heard from for this long reads "nothing seen"
 MAX_ALT_OFFSET_M = 1.5  # estimate (height over what is below) minus mocap altitude, at most
 ALT_RESEND_M = 0.01  # re-aim the altitude hold when the setpoint moved this much
+OFFSET_JUMP_M = 0.1  # estimate-minus-mocap change between looks that is a surface change
 ALT_RATE_MPS = 0.4  # altitude set positions move at this rate (a jump upsets the estimator)
 POLL_S = 0.1
 
@@ -64,6 +65,7 @@ class Craft:
         self._b = _Books()
         self._target_n: Vec3 | None = None
         self._alt_sent_m: float | None = None
+        self._offset_m: float | None = None
         station.add_record_listener(self._on_record)
 
     # -------------------------------------------------------------- loop thread
@@ -171,8 +173,12 @@ class Craft:
                                    f"{MAX_ALT_OFFSET_M} m: no furniture is that tall)")
         setpoint = -target[2] + offset
         if self._alt_sent_m is None or abs(setpoint - self._alt_sent_m) >= ALT_RESEND_M:
-            self.station.alt_hold(True, setpoint, rate_mps=ALT_RATE_MPS)
+            # a jump of the estimate (the sonar found a new surface) moves the setpoint with it
+            # at once, or the controller chases the jump; a new target altitude ramps
+            jumped = self._offset_m is not None and abs(offset - self._offset_m) > OFFSET_JUMP_M
+            self.station.alt_hold(True, setpoint, rate_mps=None if jumped else ALT_RATE_MPS)
             self._alt_sent_m = setpoint
+        self._offset_m = offset
 
     def error_m(self, target_n: Vec3) -> float:
         """3-D distance from the set position as motion capture sees it."""
