@@ -92,24 +92,25 @@ def onboard_flight(profile: str, hold_s: float, seed: int) -> dict[str, float]:
         runner.arm()
         runner.phase = Phase.TAKEOFF
         st.alt_hold(True, 1.0, rate_mps=0.5)
-        runner._wait("take-off", lambda s: s.estimate is not None
+        runner.wait("take-off", lambda s: s.estimate is not None
                      and abs(s.estimate.alt_m - 1.0) < 0.05, 20.0)
-        runner._sleep(4.0)
+        runner.pause(4.0)
         # centred sticks: mid throttle is "hold this altitude" in ALT_HOLD
         st.set_sticks(1500, 1500, 1500, 1500)
         st.alt_hold(False)
+        runner.expected_modes.add(FlightMode.ALT_HOLD)
         st.set_mode(FlightMode.ALT_HOLD)
-        runner._wait("ALT_HOLD", lambda s: s.vehicle_mode == FlightMode.ALT_HOLD, 5.0)
-        runner._sleep(2.0)  # the handover transient is not the hold
+        runner.wait("ALT_HOLD", lambda s: s.vehicle_mode == FlightMode.ALT_HOLD, 5.0)
+        runner.pause(2.0)  # the handover transient is not the hold
         runner.phase = Phase.HOLD
         t0 = st.clock.now_s()
-        runner._sleep(hold_s)
+        runner.pause(hold_s)
         origin = runner.truth_origin_m() or 0.0
         alts = np.array([s.truth_alt_m - origin for s in runner.samples
                          if s.phase is Phase.HOLD and s.t_s >= t0 and s.truth_alt_m is not None])
         # back to STABILIZE under the PC loop (bumpless from the centred stick), then land
         st.set_mode(FlightMode.STABILIZE)
-        runner._wait("STABILIZE", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 5.0)
+        runner.wait("STABILIZE", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 5.0)
         st.alt_hold(True)
         runner.land()
     err = alts - 1.0

