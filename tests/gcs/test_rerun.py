@@ -119,9 +119,11 @@ def test_unchanged_parameters_rerun_bit_identical(flight: Path) -> None:
 
 
 def test_a_changed_altitude_gain_moves_only_the_controller(flight: Path) -> None:
-    report = _report(flight, "alt.kp=12.0,alt.ki=3")
+    g = StationConfig().altitude.gains
+    report = _report(flight, f"alt.kp={g.kp + 3.0},alt.ki=3")
     assert not report.identical
-    assert report.overrides == ("altitude.gains.kp: 9.0 -> 12.0", "altitude.gains.ki: 5.0 -> 3.0")
+    assert report.overrides == (f"altitude.gains.kp: {g.kp} -> {g.kp + 3.0}",
+                                f"altitude.gains.ki: {g.ki} -> 3.0")
     by_name = {s.signal: s for s in report.signals}
     # open loop on the recorded sensor data: the estimate cannot change, the controller must
     assert all(s.identical for n, s in by_name.items() if n.startswith(topics.ESTIMATE))
@@ -160,7 +162,8 @@ def test_cli_json_and_text(flight: Path, capsys: pytest.CaptureFixture[str]) -> 
 def test_gains_from_a_toml_file(flight: Path, tmp_path: Path,
                                 capsys: pytest.CaptureFixture[str]) -> None:
     toml = tmp_path / "tune.toml"
-    toml.write_text("[altitude.gains]\nkp = 9.0\n")  # the recorded value: still identical
+    kp = StationConfig().altitude.gains.kp
+    toml.write_text(f"[altitude.gains]\nkp = {kp}\n")  # the recorded value: still identical
     assert main(["replay", str(flight), "--rerun", "--json", "--gains", str(toml)]) == 0
     assert json.loads(capsys.readouterr().out)["bit_identical"] is True
     toml.write_text("[altitude]\nmass_kg = 1.8\n")
