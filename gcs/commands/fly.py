@@ -155,6 +155,9 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
     plan = _plan(args)
     if args.speedup <= 0 or args.speedup > 50:
         raise UsageError(f"--speedup {args.speedup}: expected 0 < speedup <= 50")
+    if args.speedup != 1.0 and args.connect is not None:
+        raise UsageError("--speedup applies to the bundled SITL only; a vehicle at --connect "
+                         "flies in real time")
     key = None
     if args.signing_key is not None:
         try:
