@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
-from gcs.cli import main
 from gcs.mission import recording as topics
 from logs import open_recording
 
@@ -16,13 +17,16 @@ MISSION = Path(__file__).resolve().parents[2] / "missions" / "epbha_table.toml"
 
 @pytest.mark.e2e
 @pytest.mark.timeout(240)
-def test_epbha_table_on_the_sitl_reaches_the_box_without_collisions(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["mission", "run", str(MISSION), "--speedup", "2", "--seed", "3", "--json",
-                 "-o", str(tmp_path)])
-    out = capsys.readouterr().out.strip().splitlines()
+def test_epbha_table_on_the_sitl_reaches_the_box_without_collisions(tmp_path: Path) -> None:
+    # a fresh process, as a user runs it: the station's loop shares nothing with other tests
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "mission", "run", str(MISSION), "--speedup", "2",
+         "--seed", "3", "--json", "-o", str(tmp_path)],
+        capture_output=True, text=True, timeout=200, check=False)
+    out = proc.stdout.strip().splitlines()
+    assert out, f"exit {proc.returncode}: {proc.stderr.strip()}"
     d = json.loads(out[-1])
-    assert code == 0, d
+    assert proc.returncode == 0, d
     assert d["status"] == "reached" and d["mode"] == "vehicle"
     # collisions of the airframe's contact body with the world's boxes, from SITL ground truth
     assert d["collision_source"] == "truth" and d["truth_samples"] > 500

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
-from gcs.cli import main
 from gcs.mission import recording as topics
 from gcs.mission.world import load_world
 from logs import open_recording
@@ -17,19 +18,24 @@ ROOT = Path(__file__).resolve().parents[2]
 
 @pytest.mark.e2e
 @pytest.mark.timeout(240)
-def test_a_short_mapping_flight_samples_the_sitl_field(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_short_mapping_flight_samples_the_sitl_field(tmp_path: Path) -> None:
     text = (ROOT / "missions" / "radiation_3src.toml").read_text()
     text = text.replace("max_samples = 400", "max_samples = 6")
     text = text.replace('"../worlds/', f'"{ROOT}/worlds/')
     mission = tmp_path / "smoke.toml"
     mission.write_text(text)
     plot = tmp_path / "smoke.png"
-    code = main(["mission", "run", str(mission), "--speedup", "2", "--seed", "4", "--json",
-                 "-o", str(tmp_path), "--plot", str(plot)])
-    d = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    # a fresh process, as a user runs it: the station's loop shares nothing with other tests
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "mission", "run", str(mission), "--speedup", "2",
+         "--seed", "4", "--json", "-o", str(tmp_path), "--plot", str(plot)],
+        capture_output=True, text=True, timeout=200, check=False)
+    out = proc.stdout.strip().splitlines()
+    assert out, f"exit {proc.returncode}: {proc.stderr.strip()}"
+    d = json.loads(out[-1])
     # six samples cannot map three sources: the mission says so and exits 3
-    assert code == 3
+    assert proc.returncode == 3
+    assert proc.stderr.strip().endswith("sample budget of 6 spent")
     assert d["status"] == "failed" and "budget of 6" in d["reason"]
     assert d["samples"] == 6 and d["collisions"] == 0 and d["mode"] == "vehicle"
     rec = open_recording(d["recording"])
