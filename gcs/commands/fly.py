@@ -7,24 +7,18 @@ With no `--connect` it starts the bundled SITL and flies that. `--json` prints o
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
 import sys
 from pathlib import Path
 from typing import Any
 
-from firmware_link import LinkError, LinkUsageError, MocapLink, VehicleLink, load_signing_key
 from firmware_link.records import Dialect
-from gcs.clock import Clock, MonotonicClock, ScaledClock
-from gcs.config import load_config
+from gcs.clock import Clock
 from gcs.errors import UsageError
 from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
-from gcs.sitl_process import SitlOptions, SitlProcess
-from gcs.station import Station, StationSnapshot
-from gcs.thrust_curve import ThrottleCurve
-
-CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
+from gcs.session import SessionOptions, StationSession
+from gcs.station import StationSnapshot
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -63,17 +57,6 @@ def _plan(args: argparse.Namespace) -> FlightPlan:
         return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step)
     except ValueError as exc:
         raise UsageError(f"--alt/--hold/--step: {exc}") from None
-
-
-def _open_recorder(args: argparse.Namespace, meta: dict[str, str]) -> Any:
-    if not args.record:
-        return None
-    from logs import Recorder, RecordingError
-
-    try:
-        return Recorder(args.output, metadata=meta)
-    except RecordingError as exc:
-        raise UsageError(f"-o {args.output}: {exc}") from None
 
 
 class LivePrinter:
@@ -151,63 +134,29 @@ def _print_summary(d: dict[str, Any]) -> None:
 
 def fly(args: argparse.Namespace) -> dict[str, Any]:
     """Run the whole flight; return the summary dict (the CLI prints it)."""
-    config = load_config(args.config)
     plan = _plan(args)
-    if args.speedup <= 0 or args.speedup > 50:
-        raise UsageError(f"--speedup {args.speedup}: expected 0 < speedup <= 50")
     if args.speedup != 1.0 and args.connect is not None:
         raise UsageError("--speedup applies to the bundled SITL only; a vehicle at --connect "
                          "flies in real time")
-    key = None
-    if args.signing_key is not None:
-        try:
-            key = load_signing_key(args.signing_key)
-        except (LinkUsageError, OSError, ValueError) as exc:
-            raise UsageError(f"--signing-key {args.signing_key}: {exc}") from None
-    if args.world is not None and not args.world.is_file():
-        raise UsageError(f"--world {args.world}: no such file")
-    clock: Clock = MonotonicClock() if args.speedup == 1.0 else ScaledClock(args.speedup)
-    with contextlib.ExitStack() as stack:
-        url, mocap_url = args.connect, args.mocap
-        if url is None:
-            sitl = SitlProcess(SitlOptions(profile=args.profile, world=args.world,
-                                           speedup=args.speedup, serial=args.serial,
-                                           seed=args.seed, signing_key=args.signing_key))
-            endpoints = sitl.start()
-            stack.callback(sitl.stop)
-            url = endpoints.url(1, serial=args.serial)
-            mocap_url = mocap_url or endpoints.mocap
-        recorder = _open_recorder(args, {"command": "fly", "url": url})
-        if recorder is not None:
-            stack.callback(recorder.close)
-        link = VehicleLink.open(url, signing_key=key, clock=clock.now_s,
-                                on_raw=recorder.put_raw if recorder is not None else None)
-        stack.callback(link.close)
-        link.bring_up(40.0)
-        params: dict[str, float] = {}
-        for name in CURVE_PARAMS.get(link.dialect, ()):
-            with contextlib.suppress(LinkError):
-                params[name] = link.get_param(name)
-        curve = ThrottleCurve.for_dialect(link.dialect, params)
-        mocap = None
-        if mocap_url is not None:
-            mocap = MocapLink.open(mocap_url, clock=clock.now_s)
-            stack.callback(mocap.close)
-        station = Station(link, config=config, curve=curve, mocap=mocap, recorder=recorder,
-                          clock=clock)
-        station.start()
-        stack.callback(station.stop)
-        runner = FlightRunner(station, plan, LivePrinter(clock) if args.live else None)
+    options = SessionOptions(
+        command="fly", connect=args.connect, mocap=args.mocap, profile=args.profile,
+        world=args.world, serial=args.serial, speedup=args.speedup, seed=args.seed,
+        config=args.config, signing_key=args.signing_key, record=args.record,
+        output=args.output,
+    )
+    with StationSession(options) as session:
+        v = session.first
+        v.station.start()
+        printer = LivePrinter(session.clock) if args.live else None
+        runner = FlightRunner(v.station, plan, printer)
         try:
             runner.fly()
         except BaseException:
             # leave the vehicle to its own failsafe with the throttle at minimum, not mid-air
-            station.kill()
+            v.station.kill()
             raise
-        summary = runner.summary()
-        path = str(recorder.path) if recorder is not None else None
-        result = _summary_dict(summary, path, link.dialect)
-    return result
+        path = str(v.recorder.path) if v.recorder is not None else None
+        return _summary_dict(runner.summary(), path, v.link.dialect)
 
 
 def run(args: argparse.Namespace) -> int:
