@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from gcs.cli import main
+from gcs.config import StationConfig
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -51,8 +52,9 @@ def test_sitl_flight_rerun_with_other_gains_differs(sitl_flight: Path,
                                                     capsys: pytest.CaptureFixture[str]) -> None:
     report = _rerun(sitl_flight, capsys, "alt.kp=13.5,alt.kd=3")
     assert report["bit_identical"] is False
-    assert report["overrides"] == ["altitude.gains.kp: 9.0 -> 13.5",
-                                   "altitude.gains.kd: 4.7 -> 3.0"]
+    gains = StationConfig().altitude.gains
+    assert report["overrides"] == [f"altitude.gains.kp: {gains.kp} -> 13.5",
+                                   f"altitude.gains.kd: {gains.kd} -> 3.0"]
     signals = {s["signal"]: s for s in report["signals"]}
     assert signals["/gcs/estimate.alt_m"]["differing"] == 0  # same sensor data, same estimate
     thr = signals["/gcs/alt_controller.throttle_us"]
