@@ -37,6 +37,16 @@ def test_apm25_over_tcp_holds_1m_and_settles_a_1m_step() -> None:
     assert s["corrupted_frames"] == 0
 
 
+def test_apm25_over_serial_pty_holds_1m() -> None:
+    """The product's own case: an APM 2.5 on a 115200-baud serial line, MAVLink 1."""
+    s = fly_json("--profile", "apm25", "--serial", "--alt", "1.0", "--hold", "20")
+    assert s["dialect"] == "apm25"
+    assert s["error_source"] == "truth"
+    assert s["rms_error_m"] <= 0.05
+    assert s["overruns"] == 0
+    assert s["corrupted_frames"] == 0
+
+
 def test_copter4_over_serial_pty_holds_1m() -> None:
     s = fly_json("--profile", "copter4", "--serial", "--alt", "1.0", "--hold", "20")
     assert s["dialect"] == "copter4"
