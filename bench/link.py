@@ -33,8 +33,9 @@ from firmware_link import VehicleLink  # noqa: E402
 from firmware_link.convert import RecordConverter  # noqa: E402
 from firmware_link.frames import FrameEndpoint  # noqa: E402
 from firmware_link.records import RcCommand  # noqa: E402
+from tests.fixture_paths import FLIGHT_TLOG  # noqa: E402
 
-FIXTURE = Path("/work/shared/fixtures/arducopter-4.7dev-sitl-flight.tlog")
+FIXTURE = FLIGHT_TLOG
 TICK_S = 0.025
 
 

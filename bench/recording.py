@@ -31,10 +31,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from logs import Recorder
 from logs.tlog import import_tlog
+from tests.fixture_paths import FLIGHT_TLOG
 from tests.logs.flightgen import record, synthetic_flight
 
 TICK_S = 0.025
-FIXTURE = Path("/work/shared/fixtures/arducopter-4.7dev-sitl-flight.tlog")
+FIXTURE = FLIGHT_TLOG
 FLOOR_P99_MS = 0.5
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from pathlib import Path
 
 import pytest
 from pymavlink import mavutil
@@ -30,8 +29,9 @@ from firmware_link.records import (
     SystemStatus,
     VfrHud,
 )
+from tests.fixture_paths import FLIGHT_TLOG
 
-FIXTURE = Path("/work/shared/fixtures/arducopter-4.7dev-sitl-flight.tlog")
+FIXTURE = FLIGHT_TLOG
 G = 9.80665
 
 

@@ -8,10 +8,9 @@ import numpy as np
 import pytest
 
 from logs import Recorder
+from tests.fixture_paths import FLIGHT_TLOG
 from tests.logs.flightgen import record, synthetic_flight
 
-FIXTURES = Path("/work/shared/fixtures")
-FLIGHT_TLOG = FIXTURES / "arducopter-4.7dev-sitl-flight.tlog"
 ANCHOR_NS = 1_795_000_000_000_000_000
 
 
