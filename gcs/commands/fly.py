@@ -10,14 +10,14 @@ import argparse
 import json
 import math
 import sys
-from pathlib import Path
 from typing import Any
 
 from firmware_link.records import Dialect
 from gcs.clock import Clock
+from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
 from gcs.errors import UsageError
 from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
-from gcs.session import SessionOptions, StationSession
+from gcs.session import StationSession
 from gcs.station import StationSnapshot
 
 
@@ -25,28 +25,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the `fly` subcommand."""
     p = sub.add_parser("fly", help="hold an altitude under the PC controller, then land",
                        description=__doc__)
-    p.add_argument("--connect", metavar="URL",
-                   help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
-                        "default: start the bundled SITL")
-    p.add_argument("--mocap", metavar="URL", help="motion-capture endpoint (tcp:HOST:PORT)")
+    add_vehicle_arguments(p)
     p.add_argument("--alt", type=float, default=1.0, help="hold altitude, m (default 1.0)")
     p.add_argument("--hold", type=float, default=30.0, help="hold time, s (default 30)")
     p.add_argument("--step", type=float, default=0.0,
                    help="after the hold, step the setpoint by this many m and score it")
-    p.add_argument("--profile", choices=("apm25", "copter4"), default="apm25",
-                   help="firmware profile of the bundled SITL (default apm25)")
-    p.add_argument("--world", type=Path, help="world TOML for the bundled SITL")
-    p.add_argument("--serial", action="store_true",
-                   help="fly the bundled SITL over its pseudo-terminal serial port (115200 baud)")
     p.add_argument("--speedup", type=float, default=1.0,
                    help="run the bundled SITL and the loop this many times faster (default 1)")
-    p.add_argument("--seed", type=int, help="seed of the bundled SITL's noise")
-    p.add_argument("--config", type=Path, help="station TOML (gains, estimator, timing)")
-    p.add_argument("--signing-key", type=Path, help="MAVLink 2 signing key file (ArduCopter 4.x)")
-    p.add_argument("--record", action=argparse.BooleanOptionalAction, default=True,
-                   help="record the flight to MCAP (default on)")
-    p.add_argument("-o", "--output", type=Path, default=Path("flights"),
-                   help="recording file or directory (default flights/)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--live", action="store_true", help="print telemetry lines while flying")
     p.set_defaults(func=run)
@@ -138,12 +123,7 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
     if args.speedup != 1.0 and args.connect is not None:
         raise UsageError("--speedup applies to the bundled SITL only; a vehicle at --connect "
                          "flies in real time")
-    options = SessionOptions(
-        command="fly", connect=args.connect, mocap=args.mocap, profile=args.profile,
-        world=args.world, serial=args.serial, speedup=args.speedup, seed=args.seed,
-        config=args.config, signing_key=args.signing_key, record=args.record,
-        output=args.output,
-    )
+    options = session_options(args, "fly")
     with StationSession(options) as session:
         v = session.first
         v.station.start()

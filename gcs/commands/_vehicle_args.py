@@ -1,0 +1,38 @@
+"""Flags every command that connects to a vehicle shares, and the session they describe."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from gcs.session import SessionOptions
+
+
+def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
+    """--connect, --mocap, the bundled SITL's choices, station config, signing, recording."""
+    p.add_argument("--connect", metavar="URL",
+                   help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
+                        "default: start the bundled SITL")
+    p.add_argument("--mocap", metavar="URL", help="motion-capture endpoint (tcp:HOST:PORT)")
+    p.add_argument("--profile", choices=("apm25", "copter4"), default="apm25",
+                   help="firmware profile of the bundled SITL (default apm25)")
+    p.add_argument("--world", type=Path, help="world TOML for the bundled SITL")
+    p.add_argument("--serial", action="store_true",
+                   help="use the bundled SITL's pseudo-terminal serial port (115200 baud)")
+    p.add_argument("--seed", type=int, help="seed of the bundled SITL's noise")
+    p.add_argument("--config", type=Path, help="station TOML (gains, estimator, timing)")
+    p.add_argument("--signing-key", type=Path, help="MAVLink 2 signing key file (ArduCopter 4.x)")
+    p.add_argument("--record", action=argparse.BooleanOptionalAction, default=True,
+                   help="record the flight to MCAP (default on)")
+    p.add_argument("-o", "--output", type=Path, default=Path("flights"),
+                   help="recording file or directory (default flights/)")
+
+
+def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
+    """The session the shared flags ask for."""
+    return SessionOptions(
+        command=command, connect=args.connect, mocap=args.mocap, profile=args.profile,
+        world=args.world, serial=args.serial, speedup=getattr(args, "speedup", 1.0),
+        seed=args.seed, config=args.config, signing_key=args.signing_key, record=args.record,
+        output=args.output,
+    )
