@@ -201,7 +201,7 @@ def test_crash_in_the_loop_releases_overrides_and_reports() -> None:
     board.fail_poll = True
     deadline = time.monotonic() + 5.0
     while st.running and time.monotonic() < deadline:
-        time.sleep(0.01)
+        time.sleep(0.01)  # polling a condition with a deadline, not synchronising
     assert not st.running
     assert isinstance(st.error, OSError)
     assert board.released == 1

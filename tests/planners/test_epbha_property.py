@@ -1,7 +1,6 @@
 """Properties over random rooms: no planner moves into an obstacle; A* is optimal on its grid."""
 
 import itertools
-from collections import deque
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -10,8 +9,9 @@ from planners.astar import astar_search, plan_astar
 from planners.dstar_lite import run_dstar_lite
 from planners.epbha import run_epbha
 from planners.geometry import Box, World
-from planners.grid import DIRECTIONS, Grid
+from planners.grid import Grid
 from planners.result import PlanStatus
+from tests.planners.test_astar import bfs_steps
 
 ROOM = Box("room", (0.0, 0.0, -1.6), (3.0, 2.0, 0.0))
 START = (0.4, 1.0, -0.8)
@@ -30,21 +30,6 @@ def rooms(draw: st.DrawFn) -> World:
         h = draw(st.floats(0.3, 1.6))
         boxes.append(Box(f"b{i}", (n0, e0, -h), (min(n0 + sn, 2.2), min(e0 + se, 2.0), 0.0)))
     return World(ROOM, tuple(boxes))
-
-
-def bfs_steps(grid: Grid, start: int, goal: int) -> int | None:
-    dist = {start: 0}
-    queue = deque([start])
-    while queue:
-        u = queue.popleft()
-        if u == goal:
-            return dist[u]
-        for d in range(len(DIRECTIONS)):
-            v = u + grid.step(d)
-            if grid.move_ok[d][u] and v not in dist:
-                dist[v] = dist[u] + 1
-                queue.append(v)
-    return None
 
 
 PROPERTY = settings(max_examples=50, deadline=None, derandomize=True,
