@@ -60,8 +60,15 @@ class StationBackend:
         if sonar is not None and sonar.t_s > self._last_sonar_t:
             self._last_sonar_t = sonar.t_s
             fresh_sonar = sonar
-        self._baseline_alt = self._baseline.update(snap.imu, fresh_sonar, snap.attitude,
-                                                   snap.t_s).alt_m
+        if not snap.armed:
+            # the thesis's dead reckoning starts at take-off: on the ground it would only
+            # integrate accelerometer bias into metres
+            if self._baseline_alt is not None:
+                self._baseline = DeadReckoningEstimator(self.station.config.estimator)
+                self._baseline_alt = None
+        else:
+            self._baseline_alt = self._baseline.update(snap.imu, fresh_sonar, snap.attitude,
+                                                       snap.t_s).alt_m
         if snap.truth is not None and math.isfinite(snap.truth.pos_n[2]):
             self._truth_m = -snap.truth.pos_n[2]  # SIMSTATE has no altitude; SIM_STATE has
         if snap.tick % HISTORY_EVERY_TICKS:
