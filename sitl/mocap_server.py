@@ -12,7 +12,7 @@ from __future__ import annotations
 import socket
 
 from sitl.link.codec import MavCodec, mavlink
-from sitl.link.endpoints import EndpointError
+from sitl.link.endpoints import listen_tcp
 from sitl.simulation import MocapFrame
 
 MOCAP_SYSID = 200
@@ -23,15 +23,7 @@ class MocapServer:
     """TCP server broadcasting ATT_POS_MOCAP."""
 
     def __init__(self, port: int, mavlink1: bool, host: str = "127.0.0.1") -> None:
-        self._listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        self._listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            self._listener.bind((host, port))
-        except OSError as exc:
-            self._listener.close()
-            raise EndpointError(exc.errno, f"mocap tcp {host}:{port}: {exc.strerror}") from None
-        self._listener.listen(4)
-        self._listener.setblocking(False)
+        self._listener = listen_tcp(host, port, backlog=4, what="mocap tcp")
         self.host = host
         self.port = self._listener.getsockname()[1]
         self._codec = MavCodec(MOCAP_SYSID, 1, mavlink1)

@@ -33,6 +33,20 @@ class EndpointError(OSError):
     """An endpoint could not be opened (port busy, bad address)."""
 
 
+def listen_tcp(host: str, port: int, backlog: int, what: str = "tcp") -> socket.socket:
+    """A non-blocking listening socket on host:port (0: any free port); EndpointError if taken."""
+    listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        listener.bind((host, port))
+    except OSError as exc:
+        listener.close()
+        raise EndpointError(exc.errno, f"{what} {host}:{port}: {exc.strerror}") from None
+    listener.listen(backlog)
+    listener.setblocking(False)
+    return listener
+
+
 class Endpoint(abc.ABC):
     """Base: a transport feeding one channel."""
 
@@ -72,15 +86,7 @@ class TcpServerEndpoint(Endpoint):
         host: str = "127.0.0.1",
     ) -> None:
         super().__init__(channel, receive)
-        self._listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        self._listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            self._listener.bind((host, port))
-        except OSError as exc:
-            self._listener.close()
-            raise EndpointError(exc.errno, f"tcp {host}:{port}: {exc.strerror}") from None
-        self._listener.listen(1)
-        self._listener.setblocking(False)
+        self._listener = listen_tcp(host, port, backlog=1)
         self.host = host
         self.port = self._listener.getsockname()[1]
         self._client: socket.socket | None = None
