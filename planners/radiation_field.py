@@ -90,6 +90,28 @@ class RadiationField:
         counts = rng.poisson(self.intensity_at(pos_n) * dwell_s)
         return float(counts) / dwell_s
 
+    def count(
+        self,
+        pos_n: np.ndarray | tuple[float, float],
+        rng: np.random.Generator,
+        max_dwell_s: float,
+        target_counts: float,
+        window_s: float,
+    ) -> tuple[float, float]:
+        """Count in windows of ``window_s`` until ``target_counts`` are in or ``max_dwell_s``
+        is spent; (counts/s, seconds counted)."""
+        if not 0.0 < window_s <= max_dwell_s:
+            raise ValueError(f"need 0 < window_s <= max_dwell_s, got {window_s}, {max_dwell_s}")
+        rate = self.intensity_at(pos_n)
+        windows = max(1, round(max_dwell_s / window_s))
+        counts, k = 0, 0
+        while k < windows:
+            counts += int(rng.poisson(rate * window_s))
+            k += 1
+            if counts >= target_counts:
+                break
+        return counts / (k * window_s), k * window_s
+
     def grid(self, xs_m: np.ndarray, ys_m: np.ndarray) -> np.ndarray:
         """Intensity on a grid, indexed ``[iy, ix]`` (rows follow ``ys_m``) as contourpy expects."""
         xx, yy = np.meshgrid(xs_m, ys_m)

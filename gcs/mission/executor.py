@@ -6,7 +6,9 @@ six IR sensors (and, for radiation, integrate the detector for a dwell), ask the
 next set position, hold it until within tolerance for a short settle time (or a timeout), and
 repeat; then lands (PC descent, LAND mode touch-down, disarm). The planner is given the set
 position it asked for once the vehicle has settled there (the thesis's exact-move assumption,
-kept honest by the tolerance), else the measured mocap position.
+kept honest by the tolerance), else the measured mocap position. The radiation mapper is given
+where the vehicle was while the detector counted (the mean mocap position), and its mission
+stops when the autopilot takes the vehicle over (a battery failsafe's LAND, say).
 
 Collisions are counted afterwards against the SITL's ground truth (`truth_check`), from take-off
 until landing begins: touching down on the goal box is the point of the EPBHA mission.
@@ -23,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from firmware_link.records import FlightMode
+from firmware_link.records import Battery, FlightMode, StatusText
 from gcs.errors import RuntimeFault
 from gcs.flight import FlightPlan, FlightRunner
 from gcs.mission.craft import Craft, go_to_all
@@ -44,10 +46,11 @@ from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.truth_check import check_contacts
 from gcs.mission.world import MissionWorld
 from gcs.session import SessionOptions, StationSession
+from gcs.station import StationSnapshot
 from planners.epbha import Epbha, Status
 from planners.flocking import FlockMission, FlockPlanner
 from planners.geometry import Vec3
-from planners.radiation import RadiationMapper
+from planners.radiation import RadiationMapper, RadiationMapperParams
 
 Progress = Callable[[str], None]
 POSITION_HOLD_FROM_M = 0.3  # take-off: hold position only once clear of the floor's friction
@@ -56,6 +59,14 @@ DESCENT_MPS = 0.3
 HANDOVER_ALT_M = 0.15  # below this (estimate), LAND mode finishes the touch-down
 STILL_MPS = 0.05  # sinking slower than this (mocap) for STILL_S: standing on something
 STILL_S = 1.0
+# Radiation: count once slower than this (mocap) and within a fraction of the leg (or the
+# tolerance) of the set position. The position hold overshoots a 1 m leg by about half a metre
+# and rings for seconds; counting over a path of length L and attributing the reading to its
+# mean position errs by about L²/24 of the field's relative curvature (<= 2/m² at 1 m height):
+# under 1 % at these speeds, less than the counting noise.
+SAMPLE_STILL_MPS = 0.3
+SAMPLE_REACH_FRACTION = 0.3
+SAMPLE_POLL_S = 0.05  # station time: the same sampling however fast the SITL runs
 
 
 @dataclass(slots=True)
@@ -90,14 +101,6 @@ class _Flight:
 
     def over_budget(self) -> bool:
         return self.elapsed_s() > self.spec.max_duration_s
-
-    def sleep(self, seconds: float) -> None:
-        """Wait on the stations' clock, watching the loops."""
-        end = self.clock.now_s() + seconds
-        while self.clock.now_s() < end:
-            for c in self.crafts.values():
-                c.snapshot()
-            time.sleep(0.05)
 
     def watch_separation(self) -> None:
         """Between looks: the smallest distance between any two vehicles (mocap)."""
@@ -313,6 +316,95 @@ def _flock_metrics(f: _Flight, messages: int, err_sq: float, err_n: int,
     }
 
 
+def off_mission(snap: StationSnapshot, t_airborne_s: float) -> str | None:
+    """Why a vehicle flying a mission in STABILIZE no longer is (None while it still is).
+
+    An autopilot failsafe (battery, GCS) switches to LAND by itself: the mission must stop
+    there, or it records readings taken on the floor as if they were flown.
+    """
+    if snap.link_lost:
+        why = "link lost"
+    elif not snap.armed:
+        why = "disarmed"
+    elif snap.vehicle_mode >= 0 and snap.vehicle_mode != FlightMode.STABILIZE:
+        try:
+            why = f"switched to {FlightMode(snap.vehicle_mode).name}"
+        except ValueError:
+            why = f"switched to mode {snap.vehicle_mode}"
+    else:
+        return None
+    details = [f"after {t_airborne_s:.0f} s of flight"]
+    batt = snap.latest.get(Battery)
+    if isinstance(batt, Battery):
+        details.append(f"battery {batt.voltage_v:.2f} V"
+                       + (f" {batt.remaining_pct} %" if batt.remaining_pct >= 0 else ""))
+    text = snap.latest.get(StatusText)
+    if isinstance(text, StatusText) and "failsafe" in text.text.lower():
+        details.append(f"vehicle said '{text.text}'")
+    return f"vehicle {why} ({', '.join(details)})"
+
+
+def _hold_for_sample(f: _Flight, craft: Craft, target: Vec3, leg_m: float,
+                     timeout_s: float) -> bool:
+    """Fly to `target` until the vehicle is near it and nearly still; False on timeout.
+
+    A radiation reading is attributed to where the vehicle was while counting (see `_dwell`),
+    so it need not be exactly at the set position: near it and slow is as good a sample, and
+    the mapper is told where it was taken. Waiting instead for the position hold's ringing to
+    die down within centimetres of every set position spent the battery before the map was
+    done (about 6 s a sample instead of 4).
+    """
+    reach_m = max(f.spec.position_tolerance_m, SAMPLE_REACH_FRACTION * leg_m)
+    craft.command(target)
+    start = f.clock.now_s()
+    last: tuple[float, Vec3] | None = None
+    still_since: float | None = None
+    while True:
+        now = f.clock.now_s()
+        craft.refresh()
+        here = craft.position_n()
+        speed = math.inf
+        if last is not None and now > last[0]:
+            speed = math.dist(here[:2], last[1][:2]) / (now - last[0])
+        last = (now, here)
+        if math.dist(here, target) <= reach_m and speed <= SAMPLE_STILL_MPS:
+            still_since = now if still_since is None else still_since
+            if now - still_since >= f.spec.settle_s:
+                return True
+        else:
+            still_since = None
+        if now - start >= timeout_s:
+            return False
+        f.clock.sleep_until(now + SAMPLE_POLL_S)
+
+
+def _dwell(f: _Flight, craft: Craft, p: RadiationMapperParams) -> tuple[float, float, Vec3]:
+    """Integrate the detector while holding: (mean counts/s, seconds counted, mean mocap
+    position over the dwell).
+
+    Counting stops at `p.dwell_s`, or once `p.target_counts` are in (the detector reports
+    counts/s over windows of `p.detector_window_s`). The reading is attributed to where the
+    vehicle was while counting, not to one look at the end: position hold wanders by
+    centimetres, and near a source the rate changes by several per cent per centimetre.
+    """
+    t0 = f.clock.now_s()
+    end = t0 + p.dwell_s
+    seen: list[Vec3] = []
+    got: list[float] = []
+    while f.clock.now_s() < end:
+        seen.append(craft.position_n())
+        got = [r.counts_per_s for r in craft.radiation_since(t0)]
+        if got and p.target_counts > 0.0 and sum(got) * p.detector_window_s >= p.target_counts:
+            break
+        f.clock.sleep_until(f.clock.now_s() + SAMPLE_POLL_S)
+    seen.append(craft.position_n())
+    got = [r.counts_per_s for r in craft.radiation_since(t0)]
+    cps = float(np.mean(got)) if got else math.nan
+    mean = np.mean(np.array(seen), axis=0)
+    counted_s = len(got) * p.detector_window_s if got else p.dwell_s
+    return cps, counted_s, (float(mean[0]), float(mean[1]), float(mean[2]))
+
+
 def _radiation(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3],
                mw: MissionWorld) -> _Outcome:
     spec = f.spec
@@ -327,15 +419,17 @@ def _radiation(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3],
     f.go({v: target}, timeout_s=spec.step_timeout_s + math.dist(hover[v], target) / TRAVEL_MPS)
     path: list[Vec3] = [target]
     k = 0
+    stopped: str | None = None
     while True:
-        t0 = f.clock.now_s()
-        f.sleep(p.dwell_s)
-        got = craft.radiation_since(t0)
-        cps = float(np.mean([r.counts_per_s for r in got])) if got else math.nan
-        m = craft.position_n()
-        decision = mapper.step((m[0], m[1]), cps)
+        cps, counted_s, m = _dwell(f, craft, p)
+        stopped = off_mission(craft.snapshot(), f.elapsed_s())
+        if stopped is not None:
+            f.say(f"sample {k:4d} dropped: {stopped}")
+            break
+        decision = mapper.step((m[0], m[1]), cps, counted_s)
         t = f.clock.now_s()
-        f.rec.put(SAMPLE_RADIATION, t, radiation_payload(k, m, cps, decision))
+        f.rec.put(SAMPLE_RADIATION, t,
+                  {**radiation_payload(k, m, cps, decision), "dwell_s": counted_s})
         f.rec.pose(t, m)
         f.say(f"sample {k:4d} at ({m[0]:+6.2f}, {m[1]:+6.2f}) {cps:8.1f} cps "
               f"{decision.phase.value:11s} {decision.reason}")
@@ -343,13 +437,15 @@ def _radiation(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3],
             break
         nxt: Vec3 = (float(decision.next_pos_n[0]), float(decision.next_pos_n[1]), -alt)
         leg = math.dist(m, nxt)
-        f.go({v: nxt}, timeout_s=spec.step_timeout_s + leg / TRAVEL_MPS)
+        _hold_for_sample(f, craft, nxt, leg, spec.step_timeout_s + leg / TRAVEL_MPS)
         path.append(nxt)
         k += 1
     path_xy = np.array([(q[0], q[1]) for q in path])
     metrics, products = finish_radiation(mapper, field_, path_xy, f.rec, f.clock.now_s())
     ok, why = is_reached(metrics, setup.min_iou)
-    if f.over_budget() and not mapper.done:
+    if stopped is not None:
+        ok, why = False, f"{stopped} at sample {k}"
+    elif f.over_budget() and not mapper.done:
         ok, why = False, f"mission time {spec.max_duration_s:g} s spent"
     return _Outcome(MissionStatus.REACHED if ok else MissionStatus.FAILED, why, k, path,
                     metrics, (field_, products))

@@ -37,7 +37,7 @@ from planners.flocking import FlockMission, FlockPlanner, FlockStep
 from planners.geometry import Vec3
 from planners.kinematic import KinematicParams, KinematicSim
 from planners.proximity import ProximityParams, ProximityReading
-from planners.radiation import RadiationMapper
+from planners.radiation import RadiationMapper, take_reading
 
 NOMINAL_SPEED_MPS = 0.5  # a 0.1 m grid step every 0.2 s, as the flock runner assumes
 RADIATION_SPEED_MPS = 1.0
@@ -233,10 +233,11 @@ def run_radiation_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerS
     k = 0
     rec.scene(t0, mw.world.room, mw.world.obstacles)
     while True:
-        cps = field.sample(pos, rng, p.dwell_s)
-        t += p.dwell_s
-        decision = mapper.step(pos, cps)
-        rec.put(SAMPLE_RADIATION, t0 + t, radiation_payload(k, pos, cps, decision))
+        cps, dwell_s = take_reading(field, pos, rng, p)
+        t += dwell_s
+        decision = mapper.step(pos, cps, dwell_s)
+        rec.put(SAMPLE_RADIATION, t0 + t,
+                {**radiation_payload(k, pos, cps, decision), "dwell_s": dwell_s})
         rec.pose(t0 + t, (float(pos[0]), float(pos[1]), -spec.takeoff_alt_m))
         if progress is not None:
             progress(f"sample {k:4d} at ({pos[0]:+6.2f}, {pos[1]:+6.2f}) {cps:8.1f} cps "

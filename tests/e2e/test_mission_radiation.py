@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -48,3 +49,37 @@ def test_a_short_mapping_flight_samples_the_sitl_field(tmp_path: Path) -> None:
     assert rec.topic_info[topics.MAP_MEAN].schema_name == "foxglove.Grid"
     assert rec.counts["/vehicle/radiation"] > 6
     assert plot.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(240)
+def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
+        tmp_path: Path) -> None:
+    # A small pack: the autopilot's battery failsafe switches to LAND within a minute of flight.
+    # The mission must stop there and say why, not take floor readings as mapped ones.
+    world_text, n = re.subn(r"(?m)^battery_capacity_mah = .*$", "battery_capacity_mah = 300.0",
+                            (ROOT / "worlds" / "radiation_3src.toml").read_text())
+    assert n == 1
+    world = tmp_path / "small_pack.toml"
+    world.write_text(world_text)
+    text = (ROOT / "missions" / "radiation_3src.toml").read_text()
+    text = re.sub(r'(?m)^world = .*$', f'world = "{world}"', text)
+    mission = tmp_path / "small_pack_mission.toml"
+    mission.write_text(text)
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "mission", "run", str(mission), "--speedup", "4",
+         "--seed", "5", "--json", "-o", str(tmp_path), "--plot", str(tmp_path / "p.png")],
+        capture_output=True, text=True, timeout=200, check=False)
+    out = proc.stdout.strip().splitlines()
+    assert out, f"exit {proc.returncode}: {proc.stderr.strip()}"
+    d = json.loads(out[-1])
+    assert proc.returncode == 3, d
+    assert d["status"] == "failed" and "switched to LAND" in d["reason"], d["reason"]
+    assert "battery" in d["reason"].lower()
+    rec = open_recording(d["recording"])
+    samples = [m for _, _, m in rec.messages([topics.SAMPLE_RADIATION])]
+    assert 0 < len(samples) == d["samples"]
+    # every sample kept was taken at the flight height (mocap), none on the floor
+    poses = [m for _, _, m in rec.messages([topics.POSE])]
+    assert len(poses) == len(samples)
+    assert all(0.85 < -p["pose"]["position"]["z"] < 1.15 for p in poses), poses

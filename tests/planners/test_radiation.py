@@ -215,3 +215,35 @@ def test_gp_mapped_lawnmower_beats_log_linear_at_coarse_spacing() -> None:
     assert gp.iou > linear.iou
     assert gp.mean_cps.shape == (101, 101) and np.all(gp.log_var >= 0.0)
     assert "gp map" in gp.reason
+
+
+def test_counting_to_a_target_cuts_the_dwell_and_still_maps_every_source() -> None:
+    p = RadiationMapperParams(target_counts=800)
+    r = run_radiation(THREE, p, np.random.default_rng(2026), 400)
+    assert r.status is Status.REACHED, r.reason
+    assert r.sources_enclosed == 3 and r.iou >= 0.85
+    mapper = RadiationMapper(p)
+    first = mapper.step((-9.0, -9.0), 200.0, dwell_s=1.0)
+    # a reading with a dwell that is not a positive time is dropped and counted
+    again = mapper.step(first.next_pos_n, 2500.0, dwell_s=0.0)
+    assert again.rejected_readings == 1 and again.samples == 1
+    with pytest.raises(ValueError, match="target_counts"):
+        RadiationMapperParams(target_counts=-1.0)
+    with pytest.raises(ValueError, match="detector_window_s"):
+        RadiationMapperParams(detector_window_s=2.0)
+
+
+def test_a_short_dwell_weighs_less_in_the_model() -> None:
+    # the same reading counted 0.2 s instead of 1 s is five times fewer counts: noisier, so the
+    # model's uncertainty there is larger
+    stds = []
+    for dwell in (1.0, 0.2):
+        mapper = RadiationMapper()
+        pts = [(-9.0, -9.0), (-6.0, -9.0), (-9.0, -6.0), (-6.0, -6.0)]
+        for k, q in enumerate(pts):
+            mapper.step(q, 300.0 + 10.0 * k, dwell_s=dwell)
+        est = mapper.map_estimate()
+        ix = int(np.argmin(np.abs(est.xs_m + 6.0)))
+        iy = int(np.argmin(np.abs(est.ys_m + 6.0)))
+        stds.append(float(est.log_var[iy, ix]))
+    assert stds[1] > stds[0]

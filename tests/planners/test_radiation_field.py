@@ -56,3 +56,19 @@ def test_point_source_fit_recovers_strengths_and_background() -> None:
     assert fit.height_m == pytest.approx(1.0)
     assert [s.strength_cps_at_1m for s in fit.sources] == pytest.approx([2000.0, 5000.0], rel=1e-6)
     assert fit.background_cps == pytest.approx(30.0, rel=1e-6)
+
+
+def test_counting_stops_once_the_target_counts_are_in() -> None:
+    f = RadiationField.from_tuples([(0, 0, 5000.0)], 50.0)
+    rng = np.random.default_rng(11)
+    # over the source: 5050 cps, 800 counts are in after the first 0.2 s window
+    cps, dwell = f.count((0.0, 0.0), rng, max_dwell_s=1.0, target_counts=800, window_s=0.2)
+    assert dwell == pytest.approx(0.2) and cps == pytest.approx(5050.0, rel=0.1)
+    # far away (about 100 cps): never 800 counts in a second, so the whole second is counted
+    cps, dwell = f.count((8.0, 8.0), rng, max_dwell_s=1.0, target_counts=800, window_s=0.2)
+    assert dwell == pytest.approx(1.0) and cps * dwell == round(cps * dwell)
+    # on the 2500 cps contour: 0.4 s (500 counts per window of 0.2 s)
+    cps, dwell = f.count((1.0, 0.0), rng, max_dwell_s=1.0, target_counts=800, window_s=0.2)
+    assert dwell == pytest.approx(0.4)
+    with pytest.raises(ValueError, match="window_s"):
+        f.count((0.0, 0.0), rng, max_dwell_s=0.1, target_counts=10, window_s=0.2)
