@@ -558,7 +558,16 @@ class RadiationMapper:
             self._record(pos, cps)
 
     def _climb_candidates(self) -> Generator[_Ask, tuple[np.ndarray, float], None]:
-        """Climb from each model maximum that may be an unknown hotspot."""
+        """Climb from each model maximum that may be an unknown hotspot.
+
+        Once tracing has begun, the hotspots are re-located first: a climb cut short by its fan
+        budget leaves one where the model put it, up to half a metre off, and the contour's
+        readings then look unexplained next to it (climbing them found nothing, 20 samples on
+        a 3-source floor). Before the level is chosen the climbs' own re-location stands:
+        re-fitting there too moved a peak estimate, and with it the level, on a 1-source floor.
+        """
+        if self._level is not None:
+            self._refresh_hotspots()
         while (cand := self._next_candidate()) is not None:
             pos, cps = yield _Ask(cand, Phase.PROSPECTING, "checking a possible hotspot")
             self._record(pos, cps)
