@@ -247,3 +247,25 @@ def test_a_short_dwell_weighs_less_in_the_model() -> None:
         iy = int(np.argmin(np.abs(est.ys_m + 6.0)))
         stds.append(float(est.log_var[iy, ix]))
     assert stds[1] > stds[0]
+
+
+def test_no_climb_is_spent_on_readings_a_known_source_explains() -> None:
+    # bench/radiation.py --seed 7, field 17: the first climb from the corner runs out of fans
+    # half a metre short of its source; the contour traced round it must not then look like a
+    # new hotspot (a 20-sample climb that found nothing)
+    field = RadiationField.from_tuples(
+        [(-1.4157, 4.2245, 6510.18), (5.0435, 3.6798, 6888.46), (-6.1887, 6.6137, 5116.52)],
+        68.88,
+    )
+    rng = np.random.default_rng(132854973)
+    mapper = RadiationMapper(RadiationMapperParams())
+    pos = np.array([-9.0, -9.0])
+    checks = 0
+    while True:
+        d = mapper.step(pos, field.sample(pos, rng, 1.0))
+        checks += d.reason == "checking a possible hotspot"
+        if d.done:
+            break
+        pos = np.array(d.next_pos_n)
+    assert mapper.status is Status.REACHED and len(mapper.hotspots) == 3
+    assert checks == 2  # one per source after the first, none wasted
