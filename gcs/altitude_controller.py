@@ -34,6 +34,10 @@ def _default_alt_gains() -> PidGains:
         setpoint_slew_per_s=1.0,
         setpoint_accel_per_s2=1.5,
         ff_accel=1.0,  # the output is an acceleration: the profile's own goes straight through
+        # P then asks at most 3.6 m/s², and against kd the loop closes a larger error at about
+        # kp·leash/kd ≈ 0.65 m/s: a jump of the estimate (a carpet echo believed late, a sonar
+        # reacquisition) cannot throw the vehicle at the floor or the ceiling
+        error_max=0.3,
     )
 
 

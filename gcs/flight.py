@@ -81,6 +81,9 @@ class FlightPlan:
     descent_mps: float = 0.3
     handover_alt_m: float = 0.15
     arm_timeout_s: float = 40.0
+    # disarmed on the floor before arming, so the estimator learns the accelerometer's bias
+    # from a vehicle known to stand still (over carpet it has to coast on it for up to 1.2 s)
+    rest_s: float = 3.0
 
     def __post_init__(self) -> None:
         if not 0.2 <= self.alt_m <= 3.5:
@@ -196,6 +199,7 @@ class FlightRunner:
         st.set_sticks(1500, 1500, 1500, 1000)
         st.set_mode(FlightMode.STABILIZE)
         self.wait("STABILIZE mode", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 10.0)
+        self.pause(self.plan.rest_s)
         clock = st.clock
         deadline = clock.now_s() + self.plan.arm_timeout_s
         while True:

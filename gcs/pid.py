@@ -35,14 +35,17 @@ class PidGains:
     setpoint_slew_per_s: float = math.inf  # max rate of change of the shaped setpoint
     setpoint_accel_per_s2: float = math.inf  # max change of that rate (trapezoidal profile)
     ff_accel: float = 0.0  # feed-forward gain on the shaped setpoint's acceleration
+    error_max: float = math.inf  # P and I act on the error clamped to ±this (the "leash")
 
     def __post_init__(self) -> None:
         if min(self.kp, self.ki, self.kd, self.i_max) < 0.0:
             raise ValueError(f"PID gains and i_max must be >= 0: {self}")
         if self.out_min >= self.out_max:
             raise ValueError(f"out_min must be < out_max: {self.out_min} >= {self.out_max}")
-        if min(self.d_filter_hz, self.setpoint_slew_per_s, self.setpoint_accel_per_s2) <= 0.0:
-            raise ValueError("d_filter_hz and the setpoint slew/accel limits must be > 0")
+        if min(self.d_filter_hz, self.setpoint_slew_per_s, self.setpoint_accel_per_s2,
+               self.error_max) <= 0.0:
+            raise ValueError("d_filter_hz, the setpoint slew/accel limits and error_max must "
+                             "be > 0")
 
 
 @dataclass(frozen=True, slots=True)
@@ -167,11 +170,14 @@ class Pid:
         rc = 1.0 / (2.0 * math.pi * g.d_filter_hz)
         self._d += (dt_s / (dt_s + rc)) * (d_raw - self._d)
 
-        p = g.kp * error
-        i_next = self._i + g.ki * error * dt_s
+        # a far target (or a jump of the measurement) asks no more than the leash's worth, so
+        # the derivative term, damping the rate, bounds how fast the loop closes a large error
+        leashed = min(max(error, -g.error_max), g.error_max)
+        p = g.kp * leashed
+        i_next = self._i + g.ki * leashed * dt_s
         unsat = p + i_next + self._d + ff
         # conditional integration: don't integrate further into a saturated output
-        if (unsat > g.out_max and error > 0.0) or (unsat < g.out_min and error < 0.0):
+        if (unsat > g.out_max and leashed > 0.0) or (unsat < g.out_min and leashed < 0.0):
             i_next = self._i
         self._i = min(max(i_next, -g.i_max), g.i_max)
         total = p + self._i + self._d + ff

@@ -206,7 +206,7 @@ def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunO
         attitude = frame.attitudes[-1] if frame.attitudes else None
         sonars = frame.sonars
         est = estimator.update(average_imu(list(frame.imus)), sonars[0] if sonars else None,
-                               attitude, t.t_s)
+                               attitude, t.t_s, at_rest=t.at_rest)
         for extra in sonars[1:]:
             est = estimator.update(None, extra, None, t.t_s)
         estimates[frame.log_ns] = est

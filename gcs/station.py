@@ -177,6 +177,7 @@ class TickInputs:
     alt_target_m: float | None
     alt_rate_mps: float | None
     sticks_throttle_us: int
+    at_rest: bool = False  # disarmed: the estimator was told the vehicle stands still
 
 
 @dataclass
@@ -189,6 +190,7 @@ class _State:
     alt_setpoint_m: float | None = None
     pos_setpoint: PositionSetpoint | None = None
     estimate: AltEstimate | None = None
+    at_rest: bool = False
     alt: AltControlOutput | None = None
     position: PositionCommand | None = None
     engaged: bool = False
@@ -436,7 +438,12 @@ class Station:
         imu, sonars, attitude = self._ingest(records)
         s = self._s
         lost = self.link.lost
-        est = self.estimator.update(imu, sonars[0] if sonars else None, attitude, t_s)
+        hb = self._latest.get(Heartbeat)
+        # disarmed, the motors are stopped: the vehicle stands still (the estimator checks it
+        # is on the floor); before the first heartbeat nothing is known
+        s.at_rest = isinstance(hb, Heartbeat) and not hb.armed and not lost
+        est = self.estimator.update(imu, sonars[0] if sonars else None, attitude, t_s,
+                                    at_rest=s.at_rest)
         for extra in sonars[1:]:
             est = self.estimator.update(None, extra, None, t_s)
         s.estimate = est
@@ -548,7 +555,7 @@ class Station:
             mocap_n=sum(isinstance(r, MocapPose) for r in records),
             link_lost=s.was_lost, mode=s.mode, engage_count=s.engage_count,
             alt_target_m=s.alt_target_m, alt_rate_mps=s.alt_rate_mps,
-            sticks_throttle_us=s.sticks.throttle_us))
+            sticks_throttle_us=s.sticks.throttle_us, at_rest=s.at_rest))
         rec.put(topics.ESTIMATE, t_s, est)
         if s.alt is not None:
             rec.put(topics.ALT_CONTROLLER, t_s, s.alt)

@@ -29,11 +29,13 @@ class EstimatorParams:
     reacquire_window_s: float = 3.0
     reacquire_min_s: float = 1.5  # rejections must last longer than the carpet's late echoes
     late_gap_s: float = 0.15  # a new reading after a longer silence is a late echo...
-    late_max_s: float = 1.4  # ...unless the silence outlasts any echo (then: a dropout ended)
-    late_sigma_m: float = 0.12  # extra noise of a late echo: its ping time is only bracketed
+    late_max_s: float = 1.4  # ...unless the silence outlasts any echo: then its ping is unknown
+    late_sigma_m: float = 0.12  # extra noise of a late echo shifted by the estimated climb
+    ping_jitter_s: float = 0.05  # a ping leaves within this of the reading before it
     history_s: float = 2.0  # estimate history kept to place late echoes at their ping time
     stale_after_s: float = 0.25  # no accepted sonar for longer: coasting on the accelerometer
     ground_alt_m: float = 0.10  # below this estimate a zero sonar reading means "on the floor"
+    rest_vel_sigma_mps: float = 0.01  # standing disarmed on the floor: velocity is 0 to this
     sonar_offset_m: float = 0.0  # sonar mounted this far below the centre of gravity (body z)
     rest_alt_m: float = 0.0  # centre-of-gravity height when standing on the floor
     complementary_tc_s: float = 1.0  # T of the third-order filter (gains 3/T, 3/T², 1/T³)
@@ -127,8 +129,13 @@ class AltEstimator(ABC):
         sonar: Rangefinder | None,
         attitude: Attitude | None,
         t_s: float,
+        at_rest: bool = False,
     ) -> AltEstimate:
-        """Advance to `t_s` with the newest samples (None = nothing new since the last step)."""
+        """Advance to `t_s` with the newest samples (None = nothing new since the last step).
+
+        `at_rest`: the vehicle is known to stand still (disarmed). With the sonar reading the
+        floor, the filter then knows the vertical velocity is 0, which pins the accelerometer
+        bias before take-off instead of leaving it to the sonar in flight."""
         p = self.params
         if attitude is not None:
             self._roll, self._pitch = attitude.roll_rad, attitude.pitch_rad
@@ -147,6 +154,8 @@ class AltEstimator(ABC):
         innovation = 0.0
         if sonar is not None:
             status, innovation = self._sonar(sonar, t_s, alt_before)
+        if at_rest and self._state()[0] < p.ground_alt_m:
+            self._at_rest()
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
         return AltEstimate(
@@ -172,7 +181,6 @@ class AltEstimator(ABC):
         return self._history[0][1]
 
     def _sonar(self, sonar: Rangefinder, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
-        p = self.params
         d = sonar.distance_m if sonar.valid else 0.0
         # telemetry repeats the sensor's last reading at the stream rate: only a changed value
         # is a new reading (a genuine repeat of the same value loses nothing)
@@ -180,6 +188,36 @@ class AltEstimator(ABC):
         prev_new_t_s = self._last_new_t_s
         if fresh:
             self._last_distance, self._last_new_t_s = d, t_s
+        result = self._use_reading(sonar, d, fresh, prev_new_t_s, t_s, alt_pred)
+        if fresh:
+            # the HC-SR04 sends its next ping as soon as an echo (or its timeout) is in
+            self._on_ping(t_s)
+        return result
+
+    @abstractmethod
+    def _at_rest(self) -> None:
+        """The vehicle stands on the floor: its vertical velocity is 0."""
+
+    def _on_ping(self, t_s: float) -> None:  # noqa: B027 - optional: only cloning filters need it
+        """A new ping went out about now; filters that can, remember the state at this time."""
+
+    def _late_shift(self, ping_t_s: float, alt_pred: float) -> tuple[float, float]:
+        """(climb since the ping, its variance) to move a late echo to the present."""
+        return alt_pred - self._alt_at(ping_t_s), self.params.late_sigma_m**2
+
+    def _gate_late(self, z_ping_m: float, ping_t_s: float, alt_pred: float) -> bool:
+        shift, var = self._late_shift(ping_t_s, alt_pred)
+        return self._gate(z_ping_m + shift, var)
+
+    def _correct_late(self, z_ping_m: float, ping_t_s: float, alt_pred: float, t_s: float) -> None:
+        shift, var = self._late_shift(ping_t_s, alt_pred)
+        self._correct(z_ping_m + shift, t_s, var)
+
+    def _use_reading(
+        self, sonar: Rangefinder, d: float, fresh: bool, prev_new_t_s: float, t_s: float,
+        alt_pred: float,
+    ) -> tuple[SonarStatus, float]:
+        p = self.params
         in_range = sonar.valid and p.sonar_min_m <= d <= p.sonar_max_m
         if not in_range:
             if d <= p.sonar_min_m and alt_pred < p.ground_alt_m:
@@ -192,24 +230,25 @@ class AltEstimator(ABC):
         if not fresh:
             return SonarStatus.DUPLICATE, 0.0
         z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
-        extra_var = 0.0
-        if self._initialised and p.late_gap_s < t_s - prev_new_t_s <= p.late_max_s:
-            # The HC-SR04 does not ping again before an echo is back, so a reading after a long
-            # silence is a late echo of a ping sent about when the previous reading arrived
-            # (carpet, thesis ch. 7). Move it forward by the climb estimated since then, and
-            # trust it less: that climb is itself an estimate.
-            z += alt_pred - self._alt_at(prev_new_t_s)
-            extra_var = p.late_sigma_m**2
-        innovation = z - alt_pred
+        # The HC-SR04 does not ping again before an echo is back, so a reading after a long
+        # silence is a late echo of a ping sent about when the previous reading arrived
+        # (carpet, thesis ch. 7): it measures the altitude of then, not of now.
+        late = self._initialised and p.late_gap_s < t_s - prev_new_t_s <= p.late_max_s
+        z_now = z + self._late_shift(prev_new_t_s, alt_pred)[0] if late else z
+        innovation = z_now - alt_pred
         if not self._initialised:
             # the first in-range reading sets the altitude; nothing to gate it against yet
             self._initialised = True
             self._reset_alt(z)
             self._last_sonar_t_s = t_s
             return SonarStatus.USED, innovation
-        if self._gate(z, extra_var):
+        passed = self._gate_late(z, prev_new_t_s, alt_pred) if late else self._gate(z)
+        if passed:
             self._rejected.clear()
-            self._correct(z, t_s, extra_var)
+            if late:
+                self._correct_late(z, prev_new_t_s, alt_pred, t_s)
+            else:
+                self._correct(z, t_s)
             self._last_sonar_t_s = t_s
             return SonarStatus.USED, innovation
         self._rejected_total += 1
@@ -217,7 +256,7 @@ class AltEstimator(ABC):
             self._rejected.clear()  # not consecutive: readings were accepted or absent between
         if not self._rejected:
             self._reject_run_start_s = t_s
-        self._rejected.append((t_s, z))
+        self._rejected.append((t_s, z_now))
         while self._rejected[0][0] < t_s - p.reacquire_window_s:
             self._rejected.popleft()
         recent = [r for _, r in self._rejected]
@@ -228,7 +267,7 @@ class AltEstimator(ABC):
         ):
             # the sonar has disagreed for longer than any late echo lasts and now reads steadily
             # (a box under the vehicle, or the estimate drifted while coasting): believe it
-            self._reset_alt(z)
+            self._reset_alt(z_now)
             self._rejected.clear()
             self._last_sonar_t_s = t_s
             return SonarStatus.REACQUIRED, innovation

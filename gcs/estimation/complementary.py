@@ -54,5 +54,8 @@ class ComplementaryEstimator(AltEstimator):
         self._pos_base, self._pos_corr, self._v = alt_m, 0.0, 0.0
         self._err = 0.0
 
+    def _at_rest(self) -> None:
+        self._v = 0.0
+
     def _state(self) -> tuple[float, float, float, float]:
         return self._pos_base + self._pos_corr, self._v, -self._acc_corr, math.nan

@@ -41,5 +41,8 @@ class DeadReckoningEstimator(AltEstimator):
     def _reset_alt(self, alt_m: float) -> None:
         self._h, self._v, self._prev_z = alt_m, 0.0, None
 
+    def _at_rest(self) -> None:
+        self._v = 0.0
+
     def _state(self) -> tuple[float, float, float, float]:
         return self._h, self._v, 0.0, math.nan

@@ -238,3 +238,40 @@ def test_make_estimator_and_param_validation() -> None:
         make_estimator("magic")
     with pytest.raises(ValueError, match="sonar"):
         EstimatorParams(sonar_min_m=5.0)
+
+
+def test_standing_still_disarmed_pins_velocity_and_learns_the_bias() -> None:
+    """Disarmed on the floor the vehicle's vertical velocity is 0: the filter uses it, so the
+    accelerometer's vibration cannot move the estimate and its bias is known before take-off."""
+    est = KalmanEstimator()
+    rng = np.random.default_rng(3)
+    speeds = []
+    for k in range(int(3.0 / DT)):
+        t = k * DT
+        f = body_specific_force(0.15 + rng.normal(0, 0.5), 0.0, 0.0)
+        imu = Imu(t_s=t, sysid=1, acc_b=f, gyro_b=(0, 0, 0), source="RAW_IMU")
+        r = est.update(imu, Rangefinder(t, 1, 0.0, False, "RANGEFINDER"), None, t, at_rest=True)
+        assert r.sonar_status is SonarStatus.GROUND
+        speeds.append(abs(r.vel_mps))
+    assert max(speeds[20:]) < 0.015
+    assert r.bias_mps2 == pytest.approx(0.15, abs=0.05)
+
+
+def test_late_echo_corrects_the_altitude_of_its_ping_not_of_now() -> None:
+    """Climbing at 0.5 m/s, a reading arrives after 1 s of silence carrying the altitude of
+    when its ping went out: the filter must not drag the present estimate 0.5 m down."""
+    profile = smooth_step(4.0, 1.0, 2.5, 4.0)  # 0.59 m/s at its fastest, at 6 s
+
+    def sonar(t: float, h: float) -> float | None:
+        if 6.0 < t < 7.0:
+            return None  # the echo of the ping sent at 6.0 s is late...
+        if 7.0 <= t < 7.03:
+            return profile(6.0)[0]  # ...and arrives at 7.0 s with the range of 6.0 s
+        return h
+
+    truth, est, recs = fly(KalmanEstimator(), profile, 8.0, sonar_fn=sonar, acc_noise=0.05)
+    k = int(7.0 / DT)
+    assert truth[k] - profile(6.0)[0] > 0.45  # what the echo would cost, taken as current
+    assert recs[k].sonar_status is SonarStatus.USED
+    assert abs(recs[k].innovation_m) < 0.1  # measured against the altitude of its ping time
+    assert np.max(np.abs(est[k:] - truth[k:])) < 0.05

@@ -124,3 +124,17 @@ def test_bad_gains_rejected() -> None:
 
 def _asdict(g: PidGains) -> dict:
     return {f: getattr(g, f) for f in g.__slots__}
+
+
+def test_leash_bounds_p_and_i_on_a_large_error_but_reports_the_error() -> None:
+    gains = PidGains(kp=2.0, ki=1.0, kd=0.0, i_max=3.0, out_min=-50.0, out_max=50.0,
+                     error_max=0.3)
+    pid = Pid(gains)
+    terms = pid.update(5.0, 0.0, 0.025)
+    assert terms.error == pytest.approx(5.0)
+    assert terms.p == pytest.approx(0.6)
+    assert terms.i == pytest.approx(0.3 * 0.025)
+    inside = Pid(gains).update(0.2, 0.0, 0.025)  # within the leash: plain PID
+    assert inside.p == pytest.approx(0.4)
+    with pytest.raises(ValueError):
+        PidGains(kp=1.0, ki=0.0, kd=0.0, i_max=1.0, out_min=-1.0, out_max=1.0, error_max=0.0)
