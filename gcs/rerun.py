@@ -25,12 +25,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from firmware_link.records import Attitude, Imu, Rangefinder, RcCommand
+from firmware_link.records import Attitude, Barometer, Imu, Rangefinder, RcCommand
 from gcs import params_json, topics
 from gcs.altitude_controller import AltControlOutput, AltitudeController
 from gcs.config import StationConfig, _build
 from gcs.errors import UsageError
-from gcs.estimation import AltEstimate, make_estimator
+from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
 from gcs.station import STICK_MIN_US, ControlMode, StationSetup, TickInputs, average_imu
 from gcs.thrust_curve import ThrottleCurve
 from logs import Recording, RecordingError, from_jsonable
@@ -52,6 +52,7 @@ class TickFrame:
     imus: tuple[Imu, ...]
     sonars: tuple[Rangefinder, ...]
     attitudes: tuple[Attitude, ...]
+    baros: tuple[Barometer, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -142,7 +143,7 @@ def load_flight(recording: Recording) -> RecordedFlight:
             raise UsageError(f"{name}: no {needed} topic; the recording cannot be rerun (it needs "
                              f"{topics.SETUP}, {topics.TICK} and {topics.ESTIMATE})")
     wanted = [t for t in (topics.SETUP, topics.TICK, topics.ESTIMATE, topics.ALT_CONTROLLER,
-                          topics.IMU, topics.RANGEFINDER, topics.ATTITUDE)
+                          topics.IMU, topics.RANGEFINDER, topics.ATTITUDE, topics.BAROMETER)
               if t in recording.counts]
     by_topic: dict[str, list[tuple[int, Mapping[str, Any]]]] = {t: [] for t in wanted}
     try:
@@ -164,6 +165,7 @@ def load_flight(recording: Recording) -> RecordedFlight:
 
     imus, sonars, atts = (stream(topics.IMU, Imu), stream(topics.RANGEFINDER, Rangefinder),
                           stream(topics.ATTITUDE, Attitude))
+    baros = stream(topics.BAROMETER, Barometer)
 
     def take(it: Iterator[Any], n: int, topic: str, k: int) -> tuple[Any, ...]:
         got = tuple(r for _, r in zip(range(n), it, strict=False))
@@ -177,7 +179,8 @@ def load_flight(recording: Recording) -> RecordedFlight:
         t = _decode(TickInputs, msg, f"{name} {topics.TICK}")
         frames.append(TickFrame(log_ns, t, take(imus, t.imu_n, topics.IMU, t.tick),
                                 take(sonars, t.rangefinder_n, topics.RANGEFINDER, t.tick),
-                                take(atts, t.attitude_n, topics.ATTITUDE, t.tick)))
+                                take(atts, t.attitude_n, topics.ATTITUDE, t.tick),
+                                take(baros, t.baro_n, topics.BAROMETER, t.tick)))
     estimates = {ns: _decode(AltEstimate, m, f"{name} {topics.ESTIMATE}")
                  for ns, m in by_topic[topics.ESTIMATE]}
     alts = {ns: _decode(AltControlOutput, m, f"{name} {topics.ALT_CONTROLLER}")
@@ -205,8 +208,9 @@ def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunO
             latest_att = frame.attitudes[-1]
         attitude = frame.attitudes[-1] if frame.attitudes else None
         sonars = frame.sonars
+        baro = baro_altitude_m(frame.baros[-1].pressure_pa) if frame.baros else None
         est = estimator.update(average_imu(list(frame.imus)), sonars[0] if sonars else None,
-                               attitude, t.t_s, at_rest=t.at_rest)
+                               attitude, t.t_s, at_rest=t.at_rest, baro_alt_m=baro)
         for extra in sonars[1:]:
             est = estimator.update(None, extra, None, t.t_s)
         estimates[frame.log_ns] = est

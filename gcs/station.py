@@ -27,6 +27,7 @@ from typing import Any, Protocol
 
 from firmware_link.records import (
     Attitude,
+    Barometer,
     CommandAck,
     FlightMode,
     Heartbeat,
@@ -44,7 +45,7 @@ from gcs import params_json, topics
 from gcs.altitude_controller import AltControlOutput, AltitudeController
 from gcs.clock import Clock, MonotonicClock
 from gcs.config import StationConfig
-from gcs.estimation import AltEstimate, make_estimator
+from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
 from gcs.loop import FixedRateLoop, LoopStats, TickTiming
 from gcs.position_controller import PositionCommand, PositionController, PositionSetpoint
 from gcs.thrust_curve import ThrottleCurve
@@ -178,6 +179,7 @@ class TickInputs:
     alt_rate_mps: float | None
     sticks_throttle_us: int
     at_rest: bool = False  # disarmed: the estimator was told the vehicle stands still
+    baro_n: int = 0  # barometer records ingested (the newest one went to the estimator)
 
 
 @dataclass
@@ -435,15 +437,16 @@ class Station:
         records = self.link.poll()
         if self.mocap is not None:
             records = records + list(self.mocap.poll())
-        imu, sonars, attitude = self._ingest(records)
+        imu, sonars, attitude, baro = self._ingest(records)
         s = self._s
         lost = self.link.lost
         hb = self._latest.get(Heartbeat)
         # disarmed, the motors are stopped: the vehicle stands still (the estimator checks it
         # is on the floor); before the first heartbeat nothing is known
         s.at_rest = isinstance(hb, Heartbeat) and not hb.armed and not lost
-        est = self.estimator.update(imu, sonars[0] if sonars else None, attitude, t_s,
-                                    at_rest=s.at_rest)
+        est = self.estimator.update(
+            imu, sonars[0] if sonars else None, attitude, t_s, at_rest=s.at_rest,
+            baro_alt_m=None if baro is None else baro_altitude_m(baro.pressure_pa))
         for extra in sonars[1:]:
             est = self.estimator.update(None, extra, None, t_s)
         s.estimate = est
@@ -465,11 +468,12 @@ class Station:
         for fn in self._listeners:
             fn(snap)
 
-    def _ingest(self, records: list[TelemetryRecord]) -> tuple[Imu | None, list[Rangefinder],
-                                                               Attitude | None]:
+    def _ingest(self, records: list[TelemetryRecord]) -> tuple[
+            Imu | None, list[Rangefinder], Attitude | None, Barometer | None]:
         imus: list[Imu] = []
         sonars: list[Rangefinder] = []
         attitude: Attitude | None = None
+        baro: Barometer | None = None
         rec = self.recorder
         for r in records:
             self._latest[type(r)] = r
@@ -485,6 +489,8 @@ class Station:
                 sonars.append(r)
             elif isinstance(r, Attitude):
                 attitude = r
+            elif isinstance(r, Barometer):
+                baro = r
             elif isinstance(r, LinkEvent):
                 level = EventLevel.ERROR if r.kind is LinkEventKind.LOST else EventLevel.INFO
                 self._event(r.t_s, level, f"link {r.kind.value}: {r.detail}")
@@ -494,7 +500,7 @@ class Station:
             elif isinstance(r, StatusText):
                 self._event(r.t_s, EventLevel.INFO if r.severity > 4 else EventLevel.WARNING,
                             f"vehicle: {r.text}")
-        return average_imu(imus), sonars, attitude
+        return average_imu(imus), sonars, attitude, baro
 
     def _command(self, t_s: float, dt_s: float, est: AltEstimate) -> RcCommand:
         s = self._s
@@ -553,6 +559,7 @@ class Station:
             rangefinder_n=sum(isinstance(r, Rangefinder) for r in records),
             attitude_n=sum(isinstance(r, Attitude) for r in records),
             mocap_n=sum(isinstance(r, MocapPose) for r in records),
+            baro_n=sum(isinstance(r, Barometer) for r in records),
             link_lost=s.was_lost, mode=s.mode, engage_count=s.engage_count,
             alt_target_m=s.alt_target_m, alt_rate_mps=s.alt_rate_mps,
             sticks_throttle_us=s.sticks.throttle_us, at_rest=s.at_rest))

@@ -4,7 +4,12 @@ a third-order complementary filter (as APM's inertial navigation) and a Kalman f
 from gcs.estimation.base import AltEstimate, AltEstimator, EstimatorParams, SonarStatus
 from gcs.estimation.complementary import ComplementaryEstimator
 from gcs.estimation.dead_reckoning import DeadReckoningEstimator
-from gcs.estimation.inputs import GRAVITY_MPS2, sonar_altitude_m, vertical_accel_up_mps2
+from gcs.estimation.inputs import (
+    GRAVITY_MPS2,
+    baro_altitude_m,
+    sonar_altitude_m,
+    vertical_accel_up_mps2,
+)
 from gcs.estimation.kalman import KalmanEstimator
 
 __all__ = [
@@ -16,6 +21,7 @@ __all__ = [
     "EstimatorParams",
     "KalmanEstimator",
     "SonarStatus",
+    "baro_altitude_m",
     "make_estimator",
     "sonar_altitude_m",
     "vertical_accel_up_mps2",

@@ -36,6 +36,11 @@ class EstimatorParams:
     stale_after_s: float = 0.25  # no accepted sonar for longer: coasting on the accelerometer
     ground_alt_m: float = 0.10  # below this estimate a zero sonar reading means "on the floor"
     rest_vel_sigma_mps: float = 0.01  # standing disarmed on the floor: velocity is 0 to this
+    # MS5611: ~0.12 m white noise per reading; its offset to the floor height drifts slowly
+    # (weather, temperature) and is learned against the sonar and at rest
+    baro_sigma_m: float = 0.15
+    baro_offset_walk_m_per_sqrt_s: float = 0.01
+    baro_min_alt_m: float = 0.4  # below, rotor downwash off the floor biases it (unless disarmed)
     sonar_offset_m: float = 0.0  # sonar mounted this far below the centre of gravity (body z)
     rest_alt_m: float = 0.0  # centre-of-gravity height when standing on the floor
     complementary_tc_s: float = 1.0  # T of the third-order filter (gains 3/T, 3/T², 1/T³)
@@ -130,12 +135,14 @@ class AltEstimator(ABC):
         attitude: Attitude | None,
         t_s: float,
         at_rest: bool = False,
+        baro_alt_m: float | None = None,
     ) -> AltEstimate:
         """Advance to `t_s` with the newest samples (None = nothing new since the last step).
 
         `at_rest`: the vehicle is known to stand still (disarmed). With the sonar reading the
         floor, the filter then knows the vertical velocity is 0, which pins the accelerometer
-        bias before take-off instead of leaving it to the sonar in flight."""
+        bias before take-off instead of leaving it to the sonar in flight.
+        `baro_alt_m`: a new barometric altitude (any reference), for filters that fuse it."""
         p = self.params
         if attitude is not None:
             self._roll, self._pitch = attitude.roll_rad, attitude.pitch_rad
@@ -156,6 +163,9 @@ class AltEstimator(ABC):
             status, innovation = self._sonar(sonar, t_s, alt_before)
         if at_rest and self._state()[0] < p.ground_alt_m:
             self._at_rest()
+        if baro_alt_m is not None and self._initialised and (
+                at_rest or self._state()[0] >= p.baro_min_alt_m):
+            self._baro(baro_alt_m, coasting=t_s - self._last_sonar_t_s > p.stale_after_s)
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
         return AltEstimate(
@@ -193,6 +203,10 @@ class AltEstimator(ABC):
             # the HC-SR04 sends its next ping as soon as an echo (or its timeout) is in
             self._on_ping(t_s)
         return result
+
+    @abstractmethod
+    def _baro(self, baro_alt_m: float, coasting: bool) -> None:
+        """Fuse a barometric altitude (the baselines do not: they are sonar and IMU only)."""
 
     @abstractmethod
     def _at_rest(self) -> None:

@@ -54,6 +54,9 @@ class ComplementaryEstimator(AltEstimator):
         self._pos_base, self._pos_corr, self._v = alt_m, 0.0, 0.0
         self._err = 0.0
 
+    def _baro(self, baro_alt_m: float, coasting: bool) -> None:
+        return None  # sonar and accelerometer only, as the filter this one stands for
+
     def _at_rest(self) -> None:
         self._v = 0.0
 

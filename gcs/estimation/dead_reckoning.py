@@ -41,6 +41,9 @@ class DeadReckoningEstimator(AltEstimator):
     def _reset_alt(self, alt_m: float) -> None:
         self._h, self._v, self._prev_z = alt_m, 0.0, None
 
+    def _baro(self, baro_alt_m: float, coasting: bool) -> None:
+        return None  # sonar and accelerometer only, as the filter this one stands for
+
     def _at_rest(self) -> None:
         self._v = 0.0
 

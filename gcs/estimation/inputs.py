@@ -1,4 +1,5 @@
-"""Sensor conditioning shared by the estimators: vertical acceleration and sonar altitude."""
+"""Sensor conditioning shared by the estimators: vertical acceleration, sonar and barometric
+altitude."""
 
 from __future__ import annotations
 
@@ -25,3 +26,14 @@ def vertical_accel_up_mps2(acc_b: Vec3, roll_rad: float, pitch_rad: float) -> fl
 def sonar_altitude_m(distance_m: float, roll_rad: float, pitch_rad: float) -> float:
     """Height above the floor from a body-z slant range: distance · cos(roll) · cos(pitch)."""
     return distance_m * math.cos(roll_rad) * math.cos(pitch_rad)
+
+
+_ISA_P0_PA = 101325.0
+_ISA_K_PER_M = 2.25577e-5
+_ISA_EXP = 5.25588
+
+
+def baro_altitude_m(pressure_pa: float) -> float:
+    """ISA altitude of a static pressure. Only its changes matter: the filter that uses it
+    estimates the offset to the altitude above the floor (weather, calibration, drift)."""
+    return (1.0 - (pressure_pa / _ISA_P0_PA) ** (1.0 / _ISA_EXP)) / _ISA_K_PER_M

@@ -11,7 +11,11 @@ of the altitude taken when the ping went out ("stochastic cloning", Roumeliotis 
 The clone stays fixed while the filter propagates, so its covariance with the present altitude
 says exactly how much the climb since the ping is known, and the late reading corrects the past
 altitude it measured and, through that covariance, the present state.
-Written out in scalars: a 4×4 filter is faster in plain floats than in numpy.
+A fifth state is the barometer's offset from the altitude above the floor: the MS5611 is too
+noisy and drifts too much to fly on (thesis ch. 5), but with its offset learned against the sonar
+its 40 readings a second hold the altitude while carpet echoes are late or lost, where the
+accelerometer alone (its vibration integrated) wanders by ~10 cm in a second.
+Written out in scalars: a 5×5 filter is faster in plain floats than in numpy.
 """
 
 from __future__ import annotations
@@ -20,12 +24,12 @@ import math
 
 from gcs.estimation.base import AltEstimator, EstimatorParams
 
-_N = 4  # alt_m, vel_mps, bias_mps2, alt_m at the last ping
-_ALT, _VEL, _CLONE = 0, 1, 3
+_N = 5  # alt_m, vel_mps, bias_mps2, alt_m at the last ping, baro offset_m
+_ALT, _VEL, _CLONE, _BARO = 0, 1, 3, 4
 
 
 class KalmanEstimator(AltEstimator):
-    """Four-state Kalman filter; P is kept as a symmetric 4×4 list of lists."""
+    """Five-state Kalman filter; P is kept as a symmetric 5×5 list of lists."""
 
     name = "kalman"
 
@@ -38,12 +42,13 @@ class KalmanEstimator(AltEstimator):
         self._P[2][2] = p.initial_bias_sigma_mps2**2
         self._clone()
         self._R = p.sonar_sigma_m**2
+        self._baro_started = False
 
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None:
-        h, v, b, c = self._x
+        h, v, b, c, o = self._x
         a = acc_up_mps2 - b
         half_dt2 = 0.5 * dt_s * dt_s
-        self._x = [h + v * dt_s + a * half_dt2, v + a * dt_s, b, c]
+        self._x = [h + v * dt_s + a * half_dt2, v + a * dt_s, b, c, o]
         P = self._P
         # F = I except F[0][1] = dt, F[0][2] = -dt²/2, F[1][2] = -dt; FP then (FP)Fᵀ
         fp = [
@@ -51,9 +56,11 @@ class KalmanEstimator(AltEstimator):
             [P[1][j] - dt_s * P[2][j] for j in range(_N)],
             P[2][:],
             P[3][:],
+            P[4][:],
         ]
         n = [
-            [r[0] + dt_s * r[1] - half_dt2 * r[2], r[1] - dt_s * r[2], r[2], r[3]] for r in fp
+            [r[0] + dt_s * r[1] - half_dt2 * r[2], r[1] - dt_s * r[2], r[2], r[3], r[4]]
+            for r in fp
         ]
         # process noise: accel noise enters through G = (dt²/2, dt, 0, 0); bias random walk
         qa = self.params.accel_sigma_mps2**2
@@ -63,6 +70,7 @@ class KalmanEstimator(AltEstimator):
         n[1][0] += qa * g0 * g1
         n[1][1] += qa * g1 * g1
         n[2][2] += self.params.bias_walk_mps2_per_sqrt_s**2 * dt_s
+        n[4][4] += self.params.baro_offset_walk_m_per_sqrt_s**2 * dt_s
         self._P = n
 
     def _innovation(self, z: float, row: int, extra_var: float) -> tuple[float, float]:
@@ -87,6 +95,39 @@ class KalmanEstimator(AltEstimator):
         self._x = [self._x[i] + k[i] * y for i in range(_N)]
         hp = P[row][:]
         self._P = [[P[i][j] - k[i] * hp[j] for j in range(_N)] for i in range(_N)]
+
+    def _baro(self, baro_alt_m: float, coasting: bool) -> None:
+        p = self.params
+        r = p.baro_sigma_m**2
+        if not self._baro_started:
+            self._baro_started = True
+            self._x[_BARO] = baro_alt_m - self._x[_ALT]
+            P = self._P
+            for j in range(_N):
+                P[_BARO][j] = P[j][_BARO] = 0.0
+            P[_BARO][_BARO] = r
+            return
+        # H = e_alt + e_baro: the barometer reads the altitude plus its offset
+        P = self._P
+        ph = [P[i][_ALT] + P[i][_BARO] for i in range(_N)]
+        s = ph[_ALT] + ph[_BARO] + r
+        y = baro_alt_m - (self._x[_ALT] + self._x[_BARO])
+        if y * y > (2.0 * p.gate_sigma) ** 2 * s:
+            return  # a gust on the static port or a door slamming: not the altitude
+        if coasting:
+            k = [ph[i] / s for i in range(_N)]
+            self._x = [self._x[i] + k[i] * y for i in range(_N)]
+            self._P = [[P[i][j] - k[i] * ph[j] for j in range(_N)] for i in range(_N)]
+            return
+        # While the sonar reads, the barometer's downwash and gust noise would only roughen a
+        # better altitude (and, through the velocity, the PID's D term): it learns its offset
+        # alone (a Schmidt update, the other states only "considered"), ready for the next gap.
+        k = ph[_BARO] / s
+        self._x[_BARO] += k * y
+        for j in range(_N):
+            if j != _BARO:
+                P[_BARO][j] = P[j][_BARO] = P[_BARO][j] - k * ph[j]
+        P[_BARO][_BARO] += -2.0 * k * ph[_BARO] + k * k * s
 
     def _at_rest(self) -> None:
         self._update(_VEL, 0.0, 0.0, self.params.rest_vel_sigma_mps**2)
@@ -117,7 +158,9 @@ class KalmanEstimator(AltEstimator):
         P[_CLONE][_CLONE] = P[_ALT][_ALT]
 
     def _reset_alt(self, alt_m: float) -> None:
-        # a reset follows a long disagreement, so the velocity is not trusted either
+        # a reset follows a long disagreement, so the velocity is not trusted either; the
+        # barometer has not moved, so its offset takes up the jump
+        self._x[_BARO] -= alt_m - self._x[0]
         self._x[0], self._x[1] = alt_m, 0.0
         P = self._P
         for j in range(_N):
