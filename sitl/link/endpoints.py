@@ -63,8 +63,9 @@ class Endpoint(abc.ABC):
         """Handle a readable descriptor."""
 
     @abc.abstractmethod
-    def flush(self, wall_dt_s: float) -> None:
-        """Send what the channel has queued (`wall_dt_s` since the last flush, for pacing)."""
+    def flush(self, line_dt_s: float) -> None:
+        """Send what the channel has queued (`line_dt_s`: simulated time since the last flush,
+        for pacing)."""
 
     @abc.abstractmethod
     def close(self) -> None:
@@ -133,7 +134,7 @@ class TcpServerEndpoint(Endpoint):
             finally:
                 self._client = None
 
-    def flush(self, wall_dt_s: float) -> None:
+    def flush(self, line_dt_s: float) -> None:
         if self._client is None:
             self.channel.discard_output()
             return
@@ -194,7 +195,7 @@ class UdpEndpoint(Endpoint):
         self._dest = addr
         self._receive(self.channel, data)
 
-    def flush(self, wall_dt_s: float) -> None:
+    def flush(self, line_dt_s: float) -> None:
         data = self.channel.take()
         # one datagram per frame boundary is not required by MAVLink; send in MTU-sized pieces
         for i in range(0, len(data), 1400):
@@ -240,9 +241,9 @@ class PtySerialEndpoint(Endpoint):
         if data:
             self._receive(self.channel, data)
 
-    def flush(self, wall_dt_s: float) -> None:
+    def flush(self, line_dt_s: float) -> None:
         # a burst of at most 50 ms of line time, so pacing stays smooth
-        self._credit = min(self._credit + wall_dt_s * self.bytes_per_s, 0.05 * self.bytes_per_s)
+        self._credit = min(self._credit + line_dt_s * self.bytes_per_s, 0.05 * self.bytes_per_s)
         if not self._pending:
             self._pending = self.channel.take(int(self._credit))
         if not self._pending:

@@ -120,7 +120,9 @@ class SitlServer:
                 sim.take_mocap()
             now = time.monotonic()
             for _, ep in self.endpoints:
-                ep.flush(now - last_flush)
+                # the radio runs at its baud rate in simulated time: a sped-up run must not
+                # squeeze twice the telemetry through the same wall-clock line
+                ep.flush((now - last_flush) * self.speedup)
             last_flush = now
             if -clock.seconds_until(sim.t_s) > MAX_LAG_S:
                 clock.resync(sim.t_s)
