@@ -8,11 +8,15 @@ Flights (real time, over TCP, apm25 unless told otherwise):
    reckoning, the third-order complementary filter and the Kalman filter, each with a step.
 3. The same short hold flown by the autopilot's onboard ALT_HOLD (the station keeps the
    sticks centred, or holds position from motion capture), scored against 1.0 m.
+4. Over carpet (`worlds/carpet_room.toml`: echoes up to 1.2 s late or lost), `--carpet N`
+   flights of `quadgcs fly --hold 20` at 2x, seeds 1..N: RMS and worst error against truth.
+   Issue floor: no divergence, RMS <= 15 cm.
 With motion capture (the default world has it) the station also holds the take-off spot.
 
 Prints numbers; asserts nothing.
 
     .venv/bin/python bench/alt_hold.py [--minutes 5] [--compare-s 30] [--profile apm25]
+                                       [--carpet 8]
 """
 
 from __future__ import annotations
@@ -20,10 +24,13 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import json
 import math
+import subprocess
 import sys
 import time
 from collections.abc import Iterator
+from pathlib import Path
 
 import numpy as np
 
@@ -121,6 +128,22 @@ def onboard_flight(profile: str, hold_s: float, seed: int) -> dict[str, float]:
             "mean_alt_m": float(alts.mean())}
 
 
+CARPET_WORLD = Path(__file__).resolve().parents[1] / "worlds" / "carpet_room.toml"
+
+
+def carpet_flight(profile: str, seed: int) -> dict[str, float]:
+    """One `quadgcs fly` over carpet, through the real CLI; its JSON summary."""
+    cmd = [sys.executable, "-m", "gcs", "fly", "--no-record", "--json", "--profile", profile,
+           "--world", str(CARPET_WORLD), "--seed", str(seed), "--alt", "1.0", "--hold", "20",
+           "--speedup", "2"]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300, check=False)
+    if done.returncode != 0:
+        lines = (done.stderr or done.stdout).strip().splitlines() or ["no output"]
+        raise QuadgcsError(f"carpet flight, seed {seed}: {lines[-1]}")
+    summary: dict[str, float] = json.loads(done.stdout)
+    return summary
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the flights and print a table."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -128,6 +151,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--compare-s", type=float, default=30.0, help="short holds, seconds")
     ap.add_argument("--profile", choices=("apm25", "copter4"), default="apm25")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--carpet", type=int, default=8, metavar="N", help="flights over carpet")
     args = ap.parse_args(argv)
     print(f"bench/alt_hold.py  profile={args.profile} seed={args.seed}")
     try:
@@ -157,6 +181,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"    altitude error vs 1.0 m: RMS {o['rms_cm']:.2f} cm, worst {o['max_cm']:.2f} cm "
               f"(held {o['mean_alt_m']:.3f} m on average, {o['rms_about_mean_cm']:.2f} cm RMS "
               f"about it)")
+        if args.carpet > 0:
+            print(f"\n[4] over carpet, {args.carpet} flights of 20 s at 1.0 m (2x), seeds "
+                  f"1..{args.carpet}")
+            rms, worst = [], []
+            for seed in range(1, args.carpet + 1):
+                c = carpet_flight(args.profile, seed)
+                rms.append(c["rms_error_m"] * 100)
+                worst.append(c["max_error_m"] * 100)
+                print(f"    seed {seed:2d}: RMS {rms[-1]:6.2f} cm, worst {worst[-1]:6.2f} cm")
+            print(f"    RMS {min(rms):.2f}-{max(rms):.2f} cm (median {np.median(rms):.2f}); worst "
+                  f"{max(worst):.2f} cm (floor: RMS <= 15 cm, no divergence)")
     except QuadgcsError as exc:
         print(f"bench/alt_hold.py: {exc}", file=sys.stderr)
         return 1

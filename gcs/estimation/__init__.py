@@ -1,5 +1,6 @@
 """Altitude estimation from the IMU and the sonar: a dead-reckoning baseline (thesis eq. 6.1),
-a third-order complementary filter (as APM's inertial navigation) and a Kalman filter."""
+a third-order complementary filter (as APM's inertial navigation) and a Kalman filter that also
+fuses the barometer to bridge the sonar's gaps over carpet."""
 
 from gcs.estimation.base import AltEstimate, AltEstimator, EstimatorParams, SonarStatus
 from gcs.estimation.complementary import ComplementaryEstimator
