@@ -37,6 +37,17 @@ def test_apm25_over_tcp_holds_1m_and_settles_a_1m_step() -> None:
     assert s["corrupted_frames"] == 0
 
 
+def test_copter4_over_tcp_holds_1m_and_settles_a_1m_step() -> None:
+    s = fly_json("--profile", "copter4", "--alt", "1.0", "--hold", "20", "--step", "1.0",
+                 "--speedup", "2")
+    assert s["dialect"] == "copter4"
+    assert s["error_source"] == "truth"
+    assert s["rms_error_m"] <= 0.05
+    step = s["step"]
+    assert step["overshoot_pct"] <= 15.0
+    assert step["settle_time_s"] is not None and step["settle_time_s"] <= 4.0
+
+
 def test_apm25_over_serial_pty_holds_1m() -> None:
     """The product's own case: an APM 2.5 on a 115200-baud serial line, MAVLink 1. Sped up, the
     line keeps its baud rate in simulated time (else telemetry queues for ~0.3 s and the loop
