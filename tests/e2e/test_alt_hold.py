@@ -50,26 +50,18 @@ def test_copter4_over_tcp_holds_1m() -> None:
     assert s["overruns"] == 0
 
 
-def test_apm25_over_serial_pty_holds_1m() -> None:
-    """The product's own case: an APM 2.5 on a 115200-baud serial line, MAVLink 1. Sped up, the
-    line keeps its baud rate in simulated time (else telemetry queues for ~0.3 s and the loop
-    oscillates)."""
-    s = fly_json("--profile", "apm25", "--serial", "--alt", "1.0", "--hold", "20",
+@pytest.mark.parametrize("profile", ["apm25", "copter4"])
+def test_over_serial_pty_holds_1m(profile: str) -> None:
+    """The product's own case: an APM 2.5 (or a 4.x board) on a 115200-baud serial line. Sped
+    up, the line keeps its baud rate in simulated time (else telemetry queues for ~0.3 s and the
+    loop oscillates)."""
+    s = fly_json("--profile", profile, "--serial", "--alt", "1.0", "--hold", "20",
                  "--speedup", "2")
-    assert s["dialect"] == "apm25"
+    assert s["dialect"] == profile
     assert s["error_source"] == "truth"
     assert s["rms_error_m"] <= 0.05
     assert s["overruns"] == 0
     assert s["corrupted_frames"] == 0
-
-
-def test_copter4_over_serial_pty_holds_1m() -> None:
-    s = fly_json("--profile", "copter4", "--serial", "--alt", "1.0", "--hold", "20",
-                 "--speedup", "2")
-    assert s["dialect"] == "copter4"
-    assert s["error_source"] == "truth"
-    assert s["rms_error_m"] <= 0.05
-    assert s["overruns"] == 0
 
 
 def test_carpet_late_echoes_do_not_make_it_diverge() -> None:
