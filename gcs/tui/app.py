@@ -12,7 +12,7 @@ from collections.abc import Callable
 from typing import Any
 
 from rich.text import Text
-from textual.app import App, ComposeResult
+from textual.app import App, ComposeResult, ScreenStackError
 from textual.binding import Binding
 from textual.containers import Horizontal
 from textual.widgets import Footer, RichLog
@@ -121,9 +121,16 @@ class TeleopApp(App[None]):
 
     # --- display -------------------------------------------------------------------------
 
+    def _showing(self, selector: str) -> bool:
+        """Whether the active screen holds `selector`; false while the app shuts down."""
+        try:
+            return bool(self.screen.query(selector))
+        except ScreenStackError:  # a timer that fires after the last screen was popped
+            return False
+
     def redraw(self) -> None:
         """Copy the latest view into the panels and append new messages."""
-        if self.frozen or not self.screen.query("#messages"):
+        if self.frozen or not self._showing("#messages"):
             return  # frozen by a test, or a timer firing while the screen comes or goes
         view = self.backend.view()
         for panel in self.query(".panel").results():
@@ -138,7 +145,7 @@ class TeleopApp(App[None]):
 
     def redraw_plots(self) -> None:
         """Redraw the two graphs (slower than the panels: plotext costs milliseconds)."""
-        if self.frozen or not self.screen.query(HeightPlot):
+        if self.frozen or not self._showing("HeightPlot"):
             return
         view: TeleopView = self.backend.view()
         self.query_one(HeightPlot).show(view)

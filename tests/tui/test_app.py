@@ -69,3 +69,12 @@ def test_snapshot_main_80x24(snap_compare) -> None:  # type: ignore[no-untyped-d
 
 def test_snapshot_main_large(snap_compare) -> None:  # type: ignore[no-untyped-def]
     assert snap_compare(make_app(FixedBackend(), redraw_timers=False), terminal_size=(160, 48))
+
+
+async def test_a_redraw_after_shutdown_is_a_no_op() -> None:
+    """A redraw timer may fire once more after the last screen is gone (seen on a 2-core CI)."""
+    app = make_app(FixedBackend())
+    async with app.run_test(size=(80, 24)):
+        pass
+    app.redraw()
+    app.redraw_plots()
