@@ -18,8 +18,14 @@ class EstimatorParams:
 
     sonar_min_m: float = 0.02
     sonar_max_m: float = 4.0
-    sonar_sigma_m: float = 0.02  # measurement noise used by the filters (σ 1 cm + tilt/latency)
-    accel_sigma_mps2: float = 0.5  # per-sample vertical accel noise incl. motor vibration
+    sonar_sigma_m: float = 0.01  # the HC-SR04's σ; tilt is corrected, late echoes re-timed
+    # Per-sample vertical acceleration noise the Kalman filter assumes: the vibration on a 40 Hz
+    # RAW_IMU (~0.5 m/s²) and some margin. Against the sonar this puts the filter's bandwidth,
+    # (q/r)^¼ ≈ 7 rad/s, above the altitude loop's crossover (~4.6 rad/s). With 0.5 m/s² and a
+    # 2 cm sonar σ it sat at 4.2 rad/s, on the crossover, where the D term turned ~4 cm/s of
+    # velocity error into motion. Trusting the accelerometer even less would help the hold
+    # further but widens the gates while coasting, and lets more carpet echoes through.
+    accel_sigma_mps2: float = 0.7
     bias_walk_mps2_per_sqrt_s: float = 0.01
     initial_bias_sigma_mps2: float = 0.2
     gate_sigma: float = 4.0  # Kalman innovation gate, in innovation standard deviations

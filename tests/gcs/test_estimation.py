@@ -158,27 +158,35 @@ def test_dropout_coasts_on_accelerometer_then_recovers() -> None:
     assert not recs[-1].coasting
 
 
-def test_carpet_late_echoes_and_dropouts_while_moving_stay_bounded() -> None:
+def carpet_flight(seed: int) -> tuple[np.ndarray, np.ndarray, list]:
+    """A 0.5 m climb over carpet (6-14 s): a third of the echoes are lost, the rest arrive up to
+    1.2 s late with nothing to tell them from prompt ones, and so report an older altitude."""
     prof = smooth_step(8.0, 1.0, 1.5, 3.0)
-    rng = np.random.default_rng(7)
+    rng = np.random.default_rng(seed)
 
     def sonar(t: float, h: float) -> float | None:
-        # over carpet from 6 s to 14 s: a third of the echoes are lost, the rest arrive up to
-        # 1.2 s late and so report an older altitude
         if not 6.0 <= t < 14.0:
             return h
         if rng.random() < 0.33:
             return None
         return prof(t - rng.uniform(0.0, 1.2))[0]
 
-    truth, est, recs = fly(KalmanEstimator(), prof, 18.0, sonar_fn=sonar)
-    assert sum(r.sonar_status is SonarStatus.REJECTED for r in recs) > 5
+    return fly(KalmanEstimator(), prof, 18.0, sonar_fn=sonar)
+
+
+def test_carpet_late_echoes_and_dropouts_while_moving_stay_bounded() -> None:
+    worst, errors = [], []
+    for seed in range(7, 15):
+        truth, est, recs = carpet_flight(seed)
+        assert sum(r.sonar_status is SonarStatus.REJECTED for r in recs) > 5
+        worst.append(float(np.max(np.abs(est - truth))))
+        errors.append(rms(est - truth))
+        tail = slice(int(16.0 / DT), None)
+        assert rms(est[tail] - truth[tail]) < 0.015  # back once the floor is hard again
     # random delays during a move drag the estimate for a while (a known limit), but it stays
-    # bounded and comes back once the floor is hard again
-    assert np.max(np.abs(est - truth)) < 0.35
-    assert rms(est - truth) < 0.1
-    tail = slice(int(16.0 / DT), None)
-    assert rms(est[tail] - truth[tail]) < 0.015
+    # bounded: typically under 0.3 m, never half a metre
+    assert np.median(worst) < 0.3 and max(worst) < 0.45, worst
+    assert np.median(errors) < 0.08, errors
 
 
 def test_recovers_after_a_long_sonar_lie() -> None:
@@ -200,7 +208,7 @@ def test_consistent_disagreement_reacquires() -> None:
         return h - 0.5 if t >= 10.0 else h  # a 0.5 m box slides under the vehicle
 
     _, est, recs = fly(KalmanEstimator(), hover(1.2), 14.0, sonar_fn=sonar)
-    assert sum(r.sonar_status is SonarStatus.REJECTED for r in recs) > 3
+    assert sum(r.sonar_status is SonarStatus.REJECTED for r in recs) > 5
     assert est[-1] == pytest.approx(0.7, abs=0.03)
     assert recs[-1].sonar_status in (SonarStatus.NONE, SonarStatus.USED)
 
