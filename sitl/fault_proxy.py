@@ -1,0 +1,445 @@
+"""A MAVLink-aware man in the middle that breaks a link on purpose, for fault tests.
+
+It sits between a ground station and a vehicle endpoint and relays bytes both ways:
+- TCP: listens on 127.0.0.1:PORT (0 = OS-chosen); every accepted station gets its own
+  connection to the vehicle's TCP endpoint.
+- Serial: opens the vehicle's pseudo-terminal with pyserial at 115200 baud and offers a NEW
+  pseudo-terminal whose slave path the station opens; both ways are paced at the line's baud
+  rate (in simulated time), so the station still sees a 115200-baud radio.
+
+Faults act per direction (UP = station → vehicle, DOWN = vehicle → station, or BOTH): a window
+that drops everything, random frame loss, one flipped bit per frame with some probability
+(outside the framing bytes, so the receiver sees exactly one frame whose CRC fails), and added
+delay. The byte stream is cut into MAVLink frames (`sitl.fault_frames`) so loss and flips hit
+whole frames; bytes that are not frames pass as they are (only a drop window removes them) and
+are counted.
+
+Times are simulated seconds (`time_scale` simulated seconds per wall second), so windows line
+up with a SITL and a station run `--speedup K`. Everything runs on the proxy's own thread; no
+call blocks its caller except `stop()` and `wait_until()`.
+
+    proxy = FaultProxy(target=("127.0.0.1", 5760), seed=1, time_scale=4.0).start()
+    ... station connects to proxy.address ...
+    proxy.drop("down", 15.0)           # the downlink dies now, for 15 simulated seconds
+    proxy.set("both", loss=0.3, bitflip=0.05)
+    proxy.counters("down").frames_dropped
+    proxy.stop()
+
+`python -m sitl.fault_proxy --help` runs it from a shell (`sitl.fault_proxy_cli`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import select
+import socket
+import termios
+import threading
+import time
+import tty
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import serial
+
+from sitl.fault_frames import (
+    Counters,
+    Direction,
+    FaultWindow,
+    as_direction,
+    flip_one_bit,
+)
+from sitl.fault_lanes import (
+    Lane,
+    Pair,
+    fd_reader,
+    fd_writer,
+    sock_reader,
+    sock_writer,
+)
+
+MAX_WAIT_S = 0.05
+SERIAL_BITS_PER_BYTE = 10  # 8N1
+
+
+@dataclass
+class _Settings:
+    loss: float = 0.0
+    bitflip: float = 0.0
+    delay_s: float = 0.0
+
+
+def _probability(name: str, p: float | None) -> None:
+    if p is not None and not 0.0 <= p <= 1.0:
+        raise ValueError(f"{name} must be a probability in 0..1, got {p}")
+
+
+class FaultProxy:
+    """The injector: `FaultProxy(target=(host, port))` relays TCP, `FaultProxy(serial_port=
+    path)` bridges a pseudo-terminal. After `start()`, a station connects to `address`."""
+
+    def __init__(self, target: tuple[str, int] | None = None, *, serial_port: str | None = None,
+                 listen: tuple[str, int] = ("127.0.0.1", 0), seed: int | None = 0,
+                 time_scale: float = 1.0, baud: int = 115200,
+                 connect_timeout_s: float = 2.0) -> None:
+        if (target is None) == (serial_port is None):
+            raise ValueError("give exactly one of target (TCP) and serial_port")
+        if not time_scale > 0.0:
+            raise ValueError(f"time_scale must be > 0, got {time_scale}")
+        self.target = target
+        self.serial_port = serial_port
+        self.time_scale = time_scale
+        self.baud = baud
+        self.connect_timeout_s = connect_timeout_s
+        up_seq, down_seq = np.random.SeedSequence(seed).spawn(2)
+        # one generator per direction: how much one way carries never changes the other's luck
+        self._rng = {Direction.UP: np.random.default_rng(up_seq),
+                     Direction.DOWN: np.random.default_rng(down_seq)}
+        self._settings = {Direction.UP: _Settings(), Direction.DOWN: _Settings()}
+        self._windows: list[FaultWindow] = []
+        self._station_t_s: float | None = None
+        self._counts = {Direction.UP: Counters(), Direction.DOWN: Counters()}
+        self._cond = threading.Condition()  # guards faults and counters; notified as bytes move
+        self._pairs: list[Pair] = []
+        self._listener: socket.socket | None = None
+        self._serial: serial.Serial | None = None
+        self._pty: tuple[int, int] | None = None
+        self._wake_r, self._wake_w = os.pipe()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._t0 = time.monotonic()
+        self.connections = 0
+        self.refused = 0  # stations turned away because the vehicle endpoint did not answer
+        self.error: BaseException | None = None
+        self.port = 0
+        self.serial_path: str | None = None
+        try:
+            if target is not None:
+                self._listen(listen)
+            else:
+                self._open_serial(serial_port or "")
+        except BaseException:
+            self._close_all()
+            raise
+
+    # -------------------------------------------------------------- lifecycle
+    def _listen(self, listen: tuple[str, int]) -> None:
+        self._listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self._listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self._listener.bind(listen)
+        self._listener.listen(4)
+        self._listener.setblocking(False)
+        self.port = self._listener.getsockname()[1]
+
+    def _open_serial(self, path: str) -> None:
+        self._serial = serial.Serial(path, self.baud, timeout=0, write_timeout=0)
+        vfd = self._serial.fileno()
+        os.set_blocking(vfd, False)
+        master, slave = os.openpty()
+        # raw at once, before the station opens it: no echo, no newline translation
+        tty.setraw(slave, termios.TCSANOW)
+        os.set_blocking(master, False)
+        self._pty = (master, slave)  # the slave stays open here so the master never reads EIO
+        self.serial_path = os.ttyname(slave)
+        rate = self.baud / SERIAL_BITS_PER_BYTE * self.time_scale
+        self._pairs.append(Pair(
+            up=Lane(Direction.UP, fd_reader(master), master, fd_writer(vfd), vfd, rate),
+            down=Lane(Direction.DOWN, fd_reader(vfd), vfd, fd_writer(master), master, rate),
+            close=lambda: None))
+        self.connections = 1
+
+    def start(self) -> FaultProxy:
+        """Start relaying on the proxy's thread; the proxy's clock starts now."""
+        if self._thread is not None:
+            raise RuntimeError("fault proxy already started")
+        self._t0 = time.monotonic()
+        self._thread = threading.Thread(target=self._run, name="fault-proxy", daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self, timeout_s: float = 2.0) -> None:
+        """Stop relaying and close every socket and descriptor (idempotent)."""
+        self._stop.set()
+        if self._wake_w >= 0:
+            with contextlib.suppress(OSError):
+                os.write(self._wake_w, b"x")
+        if self._thread is not None:
+            self._thread.join(timeout_s)
+        if self._thread is None or not self._thread.is_alive():
+            self._close_all()
+
+    def __enter__(self) -> FaultProxy:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    @property
+    def running(self) -> bool:
+        """True while the relay thread runs."""
+        return self._thread is not None and self._thread.is_alive()
+
+    @property
+    def address(self) -> str:
+        """What a station connects to: `tcp:127.0.0.1:PORT`, or the pseudo-terminal's path."""
+        return self.serial_path if self.serial_path is not None else f"tcp:127.0.0.1:{self.port}"
+
+    def _close_all(self) -> None:
+        with self._cond:
+            pairs, self._pairs = self._pairs, []
+        for pair in pairs:
+            pair.close()
+        if self._listener is not None:
+            self._listener.close()
+            self._listener = None
+        if self._serial is not None:
+            self._serial.close()
+            self._serial = None
+        if self._pty is not None:
+            for fd in self._pty:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+            self._pty = None
+        for fd in (self._wake_r, self._wake_w):
+            if fd >= 0:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+        self._wake_r = self._wake_w = -1
+
+    # -------------------------------------------------------------- time and faults
+    def now_s(self) -> float:
+        """Proxy time: simulated seconds since start()."""
+        return (time.monotonic() - self._t0) * self.time_scale
+
+    def monotonic_at(self, t_s: float) -> float:
+        """The `time.monotonic()` reading at proxy time `t_s`."""
+        return self._t0 + t_s / self.time_scale
+
+    def set(self, direction: Direction | str, *, loss: float | None = None,
+            bitflip: float | None = None, delay_s: float | None = None) -> None:
+        """Standing faults from now on (None leaves a setting as it is)."""
+        _probability("loss", loss)
+        _probability("bitflip", bitflip)
+        if delay_s is not None and not delay_s >= 0.0:
+            raise ValueError(f"delay must be >= 0 s, got {delay_s}")
+        with self._cond:
+            for d in as_direction(direction).lanes():
+                s = self._settings[d]
+                s.loss = s.loss if loss is None else loss
+                s.bitflip = s.bitflip if bitflip is None else bitflip
+                s.delay_s = s.delay_s if delay_s is None else delay_s
+
+    def drop(self, direction: Direction | str, duration_s: float, start_s: float = 0.0, *,
+             from_station: bool = False) -> FaultWindow:
+        """Drop everything one way (or both) for `duration_s`, from `start_s` after now (or
+        after the first station arrives)."""
+        return self.schedule(direction, start_s, duration_s, drop=True,
+                             from_station=from_station)
+
+    def schedule(self, direction: Direction | str, start_s: float, duration_s: float, *,
+                 drop: bool = False, loss: float = 0.0, bitflip: float = 0.0,
+                 delay_s: float = 0.0, from_station: bool = False) -> FaultWindow:
+        """A fault window `start_s` after now, lasting `duration_s` (simulated seconds). With
+        `from_station` it counts from the first station's arrival (its TCP connection, or its
+        first byte on the pseudo-terminal), decided on the relay thread, so no frame of the
+        station's first moments slips past. Over the standing settings the stronger loss and
+        bit-flip rates and the longer delay act."""
+        _probability("loss", loss)
+        _probability("bitflip", bitflip)
+        if not (duration_s > 0.0 and start_s >= 0.0 and delay_s >= 0.0):
+            raise ValueError(f"a window needs start >= 0, duration > 0 and delay >= 0; got "
+                             f"start {start_s}, duration {duration_s}, delay {delay_s}")
+        t = start_s if from_station else self.now_s() + start_s
+        w = FaultWindow(as_direction(direction), t, t + duration_s, drop, loss, bitflip,
+                        delay_s, from_station)
+        with self._cond:
+            self._windows.append(w)
+        return w
+
+    @property
+    def station_arrived_s(self) -> float | None:
+        """Proxy time of the first station's arrival (None: not yet)."""
+        with self._cond:
+            return self._station_t_s
+
+    def clear(self) -> None:
+        """No faults from now on: windows and standing settings gone."""
+        with self._cond:
+            self._windows.clear()
+            self._settings = {d: _Settings() for d in self._settings}
+
+    def windows(self) -> list[FaultWindow]:
+        """Every window still on the books."""
+        with self._cond:
+            return list(self._windows)
+
+    def _effective(self, d: Direction, t_s: float) -> tuple[bool, _Settings]:
+        base = self._settings[d]
+        eff = _Settings(base.loss, base.bitflip, base.delay_s)
+        dropping = False
+        for w in self._windows:
+            t = t_s
+            if w.from_station:
+                if self._station_t_s is None:
+                    continue
+                t -= self._station_t_s
+            if d in w.direction.lanes() and w.start_s <= t < w.end_s:
+                dropping = dropping or w.drop
+                eff.loss = max(eff.loss, w.loss)
+                eff.bitflip = max(eff.bitflip, w.bitflip)
+                eff.delay_s = max(eff.delay_s, w.delay_s)
+        return dropping, eff
+
+    # -------------------------------------------------------------- counters
+    def counters(self, direction: Direction | str) -> Counters:
+        """Counters of one direction (BOTH: summed)."""
+        with self._cond:
+            total = Counters()
+            for d in as_direction(direction).lanes():
+                total = total + self._counts[d]
+            return total
+
+    def wait_until(self, pred: Callable[[FaultProxy], bool], timeout_s: float) -> bool:
+        """Block (wall time) until `pred(self)` holds, tested again whenever bytes move."""
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while not pred(self):
+                left = deadline - time.monotonic()
+                if left <= 0.0:
+                    return False
+                self._cond.wait(min(left, 0.1))
+            return True
+
+    # -------------------------------------------------------------- the relay thread
+    def _ingest(self, lane: Lane, data: bytes, wall: float) -> None:
+        d = lane.direction
+        rng = self._rng[d]
+        kept = bytearray()
+        with self._cond:
+            if d is Direction.UP and self._station_t_s is None:
+                self._station_t_s = (wall - self._t0) * self.time_scale
+            dropping, eff = self._effective(d, (wall - self._t0) * self.time_scale)
+            c = self._counts[d]
+            passed, dropped, corrupted = c.frames_passed, c.frames_dropped, c.frames_corrupted
+            other, gone = c.other_bytes, c.bytes_dropped
+            for is_frame, chunk in lane.splitter.feed(data):
+                if not is_frame:
+                    if dropping:
+                        gone += len(chunk)
+                    else:
+                        other += len(chunk)
+                        kept += chunk
+                    continue
+                # three draws per frame whatever the settings: a frame's fate depends only on
+                # its place in the stream, so a seeded run repeats exactly
+                u_loss, u_flip, u_bit = rng.random(3)
+                if dropping or u_loss < eff.loss:
+                    dropped += 1
+                    gone += len(chunk)
+                elif u_flip < eff.bitflip:
+                    corrupted += 1
+                    kept += flip_one_bit(chunk, float(u_bit))
+                else:
+                    passed += 1
+                    kept += chunk
+            self._counts[d] = Counters(passed, dropped, corrupted, other, gone,
+                                       c.bytes_in + len(data), c.bytes_out + len(kept))
+            self._cond.notify_all()
+        if kept:
+            # FIFO even when the delay shrinks: a link delays, it does not reorder
+            release = max(wall + eff.delay_s / self.time_scale, lane.last_release)
+            lane.last_release = release
+            lane.queue.append((release, bytes(kept)))
+
+    def _accept(self) -> None:
+        assert self._listener is not None and self.target is not None
+        try:
+            station, _ = self._listener.accept()
+        except OSError:
+            return
+        try:
+            vehicle = socket.create_connection(self.target, self.connect_timeout_s)
+        except OSError:
+            station.close()
+            self.refused += 1
+            return
+        for s in (station, vehicle):
+            s.setblocking(False)
+            s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+
+        def close() -> None:
+            station.close()
+            vehicle.close()
+
+        sf, vf = station.fileno(), vehicle.fileno()
+        pair = Pair(
+            up=Lane(Direction.UP, sock_reader(station), sf, sock_writer(vehicle), vf),
+            down=Lane(Direction.DOWN, sock_reader(vehicle), vf, sock_writer(station), sf),
+            close=close)
+        with self._cond:
+            self._pairs.append(pair)
+            self.connections += 1
+            if self._station_t_s is None:
+                self._station_t_s = self.now_s()
+            self._cond.notify_all()
+
+    def _hang_up(self, pair: Pair, fd: int) -> None:
+        if self._listener is None:
+            pair.closed_ends.add(fd)  # a pty end went away: stop reading it, keep the other
+            return
+        with self._cond:
+            self._pairs.remove(pair)
+        pair.close()
+
+    def _service(self) -> None:
+        now = time.monotonic()
+        rfds: dict[int, tuple[Pair, Lane] | None] = {self._wake_r: None}
+        if self._listener is not None:
+            rfds[self._listener.fileno()] = None
+        wfds: list[int] = []
+        timeout = MAX_WAIT_S
+        for pair in self._pairs:
+            for lane in (pair.up, pair.down):
+                if lane.rfd not in pair.closed_ends:
+                    rfds[lane.rfd] = (pair, lane)
+                if lane.wants_write(now):
+                    wfds.append(lane.wfd)
+                timeout = min(timeout, lane.next_due_s(now))
+        readable, _, _ = select.select(list(rfds), wfds, [], timeout)
+        wall = time.monotonic()
+        for fd in readable:
+            entry = rfds[fd]
+            if fd == self._wake_r:
+                os.read(fd, 64)
+            elif entry is None:
+                self._accept()
+            elif entry[0] in self._pairs:
+                pair, lane = entry
+                data = lane.read()
+                if data == b"":
+                    self._hang_up(pair, fd)
+                elif data is not None:
+                    self._ingest(lane, data, wall)
+        for pair in self._pairs:
+            pair.up.pump(wall)
+            pair.down.pump(wall)
+
+    def _run(self) -> None:
+        try:
+            while not self._stop.is_set():
+                self._service()
+        except BaseException as exc:  # kept for the caller; the relay stops, the sockets close
+            self.error = exc
+        finally:
+            with self._cond:
+                self._cond.notify_all()
+
+
+if __name__ == "__main__":
+    import sys
+
+    from sitl.fault_proxy_cli import main
+
+    sys.exit(main())
