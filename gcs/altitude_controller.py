@@ -91,6 +91,9 @@ class AltitudeController:
         self.pid = Pid(params.gains)
         h = curve.mid_output if hover_throttle is None else hover_throttle
         self.hover_throttle = min(max(h, params.hover_min), params.hover_max)
+        # which way the last stick command was clamped (+1 at the top, -1 at the bottom): the
+        # integrator must not keep growing into a stick that cannot move further
+        self._clamped = 0
 
     def _tilt(self, roll_rad: float, pitch_rad: float) -> float:
         c = math.cos(roll_rad) * math.cos(pitch_rad)
@@ -108,19 +111,35 @@ class AltitudeController:
         if throttle_us is not None:
             a0 = self.accel_for_throttle(throttle_us, roll_rad, pitch_rad)
         self.pid.engage(estimate.alt_m, estimate.alt_m, a0)
+        self._clamped = 0
+
+    def hover_stick_us(self) -> int:
+        """The stick PWM that holds the learned hover throttle, level."""
+        p = self.params
+        stick = self.curve.stick_us(self.hover_throttle)
+        return round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
 
     def update(self, setpoint_m: float, estimate: AltEstimate, roll_rad: float, pitch_rad: float,
-               dt_s: float) -> AltControlOutput:
-        """One step: setpoint altitude (up, m) and the estimate → throttle stick PWM."""
+               dt_s: float, *, on_floor: bool = False) -> AltControlOutput:
+        """One step: setpoint altitude (up, m) and the estimate → throttle stick PWM.
+
+        `on_floor`: the vehicle stands on the floor, so thrust below its weight changes nothing
+        and the integrator must not wind up against it."""
         p = self.params
+        error = setpoint_m - estimate.alt_m
+        integrate = not (on_floor or (self._clamped > 0 and error > 0.0)
+                         or (self._clamped < 0 and error < 0.0))
         terms: PidTerms = self.pid.update(setpoint_m, estimate.alt_m, dt_s,
-                                          measurement_rate=estimate.vel_mps)
+                                          measurement_rate=estimate.vel_mps,
+                                          integrate=integrate)
         tilt = self._tilt(roll_rad, pitch_rad)
         thrust = p.mass_kg * (GRAVITY_MPS2 + terms.out) / tilt
         motor = self.hover_throttle * thrust / (p.mass_kg * GRAVITY_MPS2)
         stick = self.curve.stick_us(motor)
         throttle_us = round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
-        self._learn_hover(motor * tilt, terms, estimate, dt_s)
+        self._clamped = 1 if stick > p.throttle_max_us else -1 if stick < p.throttle_min_us else 0
+        if not on_floor:  # on the floor the throttle says nothing about the hover throttle
+            self._learn_hover(motor * tilt, terms, estimate, dt_s)
         return AltControlOutput(
             setpoint_m=terms.shaped_target,
             alt_m=estimate.alt_m,
@@ -133,7 +152,7 @@ class AltitudeController:
             motor_throttle=motor,
             hover_throttle=self.hover_throttle,
             throttle_us=throttle_us,
-            saturated=terms.saturated,
+            saturated=terms.saturated or self._clamped != 0,
         )
 
     def _learn_hover(self, level_motor: float, terms: PidTerms, est: AltEstimate,
@@ -141,7 +160,7 @@ class AltitudeController:
         p = self.params
         steady = (abs(est.vel_mps) < p.hover_learn_max_vel_mps
                   and abs(terms.error) < p.hover_learn_max_err_m
-                  and not terms.saturated and not est.coasting)
+                  and not terms.saturated and not est.coasting and self._clamped == 0)
         if not steady:
             return
         # the throttle that holds the vehicle level (without the PID's acceleration) is hover;

@@ -25,3 +25,9 @@ class MissionFailed(QuadgcsError):
     """A mission ran but did not meet its goal (not reached, deadlock): exit 3."""
 
     exit_code = 3
+
+
+class FlightFailed(QuadgcsError):
+    """A flight did not go as commanded (link lost, a mode it did not ask for, a refusal): 3."""
+
+    exit_code = 3

@@ -17,9 +17,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from firmware_link.records import FlightMode
-from gcs.errors import RuntimeFault
+from gcs.errors import FlightFailed
 from gcs.position_controller import PositionSetpoint, yaw_from_quat
-from gcs.station import ControlMode, Station, StationSnapshot
+from gcs.station import Station, StationSnapshot
+from gcs.supervisor import SupervisorState
 
 POLL_S = 0.1
 """How often the flight script looks at the station. Rarely: every look takes the GIL, and a
@@ -30,12 +31,25 @@ class Phase(enum.Enum):
     """Where the flight is."""
 
     GROUND = "ground"
+    ARMED = "armed"  # on the floor, armed, before take-off
     TAKEOFF = "takeoff"
     SETTLE = "settle"
     HOLD = "hold"
     STEP = "step"
     LAND = "land"
     DONE = "done"
+
+
+_S = SupervisorState
+PHASE_STATES: dict[Phase, frozenset[SupervisorState]] = {
+    Phase.ARMED: frozenset({_S.MANUAL}),
+    Phase.TAKEOFF: frozenset({_S.SPOOL_UP, _S.TAKEOFF, _S.HOLD}),
+    Phase.SETTLE: frozenset({_S.HOLD}),
+    Phase.HOLD: frozenset({_S.HOLD}),
+    Phase.STEP: frozenset({_S.HOLD}),
+    Phase.LAND: frozenset({_S.HOLD, _S.VEHICLE, _S.DISARMED}),
+}
+"""The supervisor states a flight phase may see; any other ends the flight as failed."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,12 +98,15 @@ class FlightPlan:
     # disarmed on the floor before arming, so the estimator learns the accelerometer's bias
     # from a vehicle known to stand still (over carpet it has to coast on it for up to 1.2 s)
     rest_s: float = 3.0
+    takeoff_delay_s: float = 0.0  # armed on the floor this long before taking off
 
     def __post_init__(self) -> None:
         if not 0.2 <= self.alt_m <= 3.5:
             raise ValueError(f"altitude {self.alt_m} m outside 0.2..3.5 m (the sonar's range)")
         if self.hold_s <= 0.0:
             raise ValueError(f"hold time must be > 0 s, got {self.hold_s}")
+        if self.takeoff_delay_s < 0.0:
+            raise ValueError(f"take-off delay must be >= 0 s, got {self.takeoff_delay_s}")
         if not 0.2 <= self.alt_m + self.step_m <= 3.5:
             raise ValueError(f"step to {self.alt_m + self.step_m} m leaves 0.2..3.5 m")
 
@@ -156,18 +173,26 @@ class FlightRunner:
         ))
 
     # -------------------------------------------------------------- waiting
+    def _why(self, snap: StationSnapshot) -> str:
+        """The supervisor's last reason and the vehicle's last words, for a failure line."""
+        notes = [e.text for e in snap.events if e.text.startswith(f"{snap.state.value}:")]
+        texts = [e.text for e in snap.events if e.text.startswith("vehicle:")]
+        why = notes[-1] if notes else f"station {snap.state.value}"
+        return why + (f" ({texts[-1]})" if texts else "")
+
     def _check(self, snap: StationSnapshot) -> None:
         if self.station.error is not None:
-            raise RuntimeFault(f"control loop stopped: {self.station.error}")
+            raise FlightFailed(f"control loop stopped: {self.station.error}")
+        allowed = PHASE_STATES.get(self.phase)
+        if allowed is not None and snap.state not in allowed:
+            raise FlightFailed(f"during {self.phase.value}: {self._why(snap)}")
         if (snap.armed and snap.vehicle_mode >= 0 and snap.vehicle_mode not in self.expected_modes
                 and self.phase not in (Phase.GROUND, Phase.DONE)):
-            texts = [e.text for e in snap.events if e.text.startswith("vehicle:")]
-            why = f" ({texts[-1]})" if texts else ""
-            raise RuntimeFault(f"vehicle left the flight's mode for mode {snap.vehicle_mode} "
-                               f"during {self.phase.value}{why}")
+            raise FlightFailed(f"vehicle left the flight's mode for mode {snap.vehicle_mode} "
+                               f"during {self.phase.value}: {self._why(snap)}")
 
     def wait(self, what: str, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> None:
-        """Wait `timeout_s` on the station's clock for `pred`; RuntimeFault naming `what`."""
+        """Wait `timeout_s` on the station's clock for `pred`; FlightFailed naming `what`."""
         clock = self.station.clock
         deadline = clock.now_s() + timeout_s
         while True:
@@ -178,7 +203,8 @@ class FlightRunner:
             if self._on_progress is not None:
                 self._on_progress(snap, self.phase)
             if clock.now_s() >= deadline:
-                raise RuntimeFault(f"{what} did not happen within {timeout_s:g} s")
+                raise FlightFailed(f"{what} did not happen within {timeout_s:g} s "
+                                   f"({self._why(snap)})")
             time.sleep(POLL_S)
 
     def pause(self, seconds: float) -> None:
@@ -194,32 +220,38 @@ class FlightRunner:
 
     # -------------------------------------------------------------- the flight
     def arm(self) -> None:
-        """STABILIZE, throttle at minimum, arm (retried: pre-arm checks may still be running)."""
+        """STABILIZE, throttle at minimum, arm. The supervisor refuses without passed pre-flight
+        checks and re-asks while the vehicle refuses (pre-arm checks still running)."""
         st = self.station
         st.set_sticks(1500, 1500, 1500, 1000)
         st.set_mode(FlightMode.STABILIZE)
         self.wait("STABILIZE mode", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 10.0)
         self.pause(self.plan.rest_s)
-        clock = st.clock
-        deadline = clock.now_s() + self.plan.arm_timeout_s
-        while True:
-            st.request_arm()
-            try:
-                self.wait("arming", lambda s: s.armed, 2.0)
-                return
-            except RuntimeFault:
-                if clock.now_s() >= deadline:
-                    reasons = [e.text for e in st.snapshot(loop_stats=False).events
-                               if "vehicle:" in e.text]
-                    why = f" ({reasons[-1]})" if reasons else ""
-                    raise RuntimeFault(f"vehicle did not arm within "
-                                       f"{self.plan.arm_timeout_s:g} s{why}") from None
+        asked_at = st.clock.now_s()
+        st.request_arm()
+
+        def armed_or_refused(s: StationSnapshot) -> bool:
+            refused = [e for e in s.events if e.t_s >= asked_at
+                       and e.text.startswith(("arm refused", "disarmed: vehicle did not arm"))]
+            if refused:
+                raise FlightFailed(f"{refused[-1].text}{self._vehicle_said(s)}")
+            return s.armed and s.state is SupervisorState.MANUAL
+
+        self.wait("arming", armed_or_refused, self.plan.arm_timeout_s)
+
+    @staticmethod
+    def _vehicle_said(snap: StationSnapshot) -> str:
+        texts = [e.text for e in snap.events if e.text.startswith("vehicle:")]
+        return f" ({texts[-1]})" if texts else ""
 
     def fly(self) -> None:
         """Take off, settle, hold, step (if asked), land and disarm."""
         p = self.plan
         st = self.station
         self.arm()
+        self.phase = Phase.ARMED
+        if p.takeoff_delay_s > 0.0:
+            self.pause(p.takeoff_delay_s)
         self.phase = Phase.TAKEOFF
         self._target = p.alt_m
         st.alt_hold(True, p.alt_m, rate_mps=p.climb_mps)
@@ -231,9 +263,10 @@ class FlightRunner:
             st.set_position_setpoint(PositionSetpoint(n, e, yaw_from_quat(pose.q_nb)))
         climb_s = p.alt_m / p.climb_mps
         self.wait("take-off to the hold altitude",
-                   lambda s: s.estimate is not None and abs(s.estimate.alt_m - p.alt_m) < 0.1
+                   lambda s: s.state is SupervisorState.HOLD and s.estimate is not None
+                   and abs(s.estimate.alt_m - p.alt_m) < 0.1
                    and s.alt_setpoint_m is not None and abs(s.alt_setpoint_m - p.alt_m) < 1e-6,
-                   climb_s + 15.0)
+                   climb_s + 20.0)
         self.phase = Phase.SETTLE
         self.pause(p.settle_s)
         self.phase = Phase.HOLD
@@ -246,31 +279,31 @@ class FlightRunner:
         self.land()
 
     def land(self) -> None:
-        """Descend under PC control to a few cm, then hand over to LAND mode, which touches
-        down and disarms by itself (a disarm request follows if it does not)."""
+        """Descend under PC control to a few cm, then ask for LAND mode, which touches down and
+        disarms by itself (a disarm request follows if it does not). PC hold stays on until a
+        heartbeat shows LAND, so the vehicle is never left without a throttle."""
         p = self.plan
         st = self.station
         self.phase = Phase.LAND
         self._target = 0.0
-        if st.snapshot(loop_stats=False).mode is not ControlMode.MANUAL:
+        if st.snapshot(loop_stats=False).state is SupervisorState.HOLD:
             st.alt_hold(True, 0.0, rate_mps=p.descent_mps)
             start = st.snapshot(loop_stats=False).estimate
             top = start.alt_m if start is not None else p.alt_m
             self.wait("descent", lambda s: s.estimate is not None
                        and s.estimate.alt_m < p.handover_alt_m, top / p.descent_mps + 15.0)
         st.set_sticks(1500, 1500, 1500, 1000)
-        st.alt_hold(False)
         self.expected_modes.add(FlightMode.LAND)
         st.set_mode(FlightMode.LAND)
         try:
             self.wait("touch-down and disarm in LAND", lambda s: not s.armed, 15.0)
-        except RuntimeFault:
+        except FlightFailed:
             for _ in range(3):
                 st.request_disarm()
                 try:
                     self.wait("disarm", lambda s: not s.armed, 3.0)
                     break
-                except RuntimeFault:
+                except FlightFailed:
                     continue
             else:
                 raise

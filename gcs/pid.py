@@ -145,8 +145,12 @@ class Pid:
         measurement: float,
         dt_s: float,
         measurement_rate: float | None = None,
+        *,
+        integrate: bool = True,
     ) -> PidTerms:
-        """One step: returns the terms and the saturated output."""
+        """One step: returns the terms and the saturated output. With `integrate` False the
+        integrator holds its value (the caller knows the actuator beyond the PID is clamped, or
+        the plant cannot respond, e.g. a vehicle standing on the floor)."""
         if dt_s <= 0.0:
             raise ValueError(f"dt_s must be > 0, got {dt_s}")
         g = self.gains
@@ -177,7 +181,8 @@ class Pid:
         i_next = self._i + g.ki * leashed * dt_s
         unsat = p + i_next + self._d + ff
         # conditional integration: don't integrate further into a saturated output
-        if (unsat > g.out_max and leashed > 0.0) or (unsat < g.out_min and leashed < 0.0):
+        if (not integrate or (unsat > g.out_max and leashed > 0.0)
+                or (unsat < g.out_min and leashed < 0.0)):
             i_next = self._i
         self._i = min(max(i_next, -g.i_max), g.i_max)
         total = p + self._i + self._d + ff

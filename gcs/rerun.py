@@ -1,17 +1,18 @@
-"""Re-fly a recorded flight's sensor data through fresh estimator and altitude-controller
+"""Re-fly a recorded flight's sensor data through fresh estimator and supervisor
 instances, and measure how their outputs differ from what the station computed in the air.
 
-The station records, per tick, which telemetry records it consumed and what the commander decided
-(`/gcs/tick`, `TickInputs`), and once its configuration and throttle curve (`/gcs/setup`). From
-these the rerun rebuilds every tick's inputs exactly as the station saw them — the same IMU
-samples averaged in the same order, the same sonar readings, the newest attitude, the same tick
-time, engagement and setpoint ramp — so with unchanged parameters every output is bit-identical
-to the recording. With changed parameters (`apply_overrides`) it shows what those gains would
-have done with the same sensor data.
+The station records, per tick, which telemetry records and intents it consumed and what it knew
+of the vehicle (`/gcs/tick`, `TickInputs`, `/gcs/intent`), and once its configuration, throttle
+curve and supervisor policy (`/gcs/setup`). From these the rerun rebuilds every tick's inputs
+exactly as the station saw them — the same IMU samples averaged in the same order, the same sonar
+readings, the newest attitude and mocap pose, the same intents and heartbeat state — so with
+unchanged parameters every output is bit-identical to the recording. With changed parameters
+(`apply_overrides`) it shows what those gains would have done with the same sensor data.
 
 Not replayed: the vehicle's response. The sensor data are those of the flight as flown, so a
 rerun with other gains is an open-loop comparison (the controller's command on the recorded
-state), not a new flight. The position controller is not rerun.
+state), not a new flight. The supervisor (and with it the position controller) is rerun from the
+recorded intents and vehicle states; its transitions follow the recorded vehicle, not a new one.
 """
 
 from __future__ import annotations
@@ -25,13 +26,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from firmware_link.records import Attitude, Barometer, Imu, Rangefinder, RcCommand
+from firmware_link.records import Attitude, Barometer, Imu, MocapPose, Rangefinder
 from gcs import params_json, topics
 from gcs.altitude_controller import AltControlOutput, AltitudeController
 from gcs.config import StationConfig, _build
 from gcs.errors import UsageError
 from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
-from gcs.station import STICK_MIN_US, ControlMode, StationSetup, TickInputs, average_imu
+from gcs.position_controller import PositionController
+from gcs.station import StationSetup, TickInputs, average_imu
+from gcs.supervisor import Intent, Supervisor, SupervisorParams, TickIn, VehicleStatus
 from gcs.thrust_curve import ThrottleCurve
 from logs import Recording, RecordingError, from_jsonable
 
@@ -53,6 +56,8 @@ class TickFrame:
     sonars: tuple[Rangefinder, ...]
     attitudes: tuple[Attitude, ...]
     baros: tuple[Barometer, ...] = ()
+    mocaps: tuple[MocapPose, ...] = ()
+    intents: tuple[Intent, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,6 +67,7 @@ class RecordedFlight:
     config: StationConfig
     curve: ThrottleCurve
     hover_throttle: float
+    supervisor: SupervisorParams
     ticks: tuple[TickFrame, ...]
     estimates: Mapping[int, AltEstimate]  # by log time (ns) of the tick
     alt_outputs: Mapping[int, AltControlOutput]
@@ -143,7 +149,8 @@ def load_flight(recording: Recording) -> RecordedFlight:
             raise UsageError(f"{name}: no {needed} topic; the recording cannot be rerun (it needs "
                              f"{topics.SETUP}, {topics.TICK} and {topics.ESTIMATE})")
     wanted = [t for t in (topics.SETUP, topics.TICK, topics.ESTIMATE, topics.ALT_CONTROLLER,
-                          topics.IMU, topics.RANGEFINDER, topics.ATTITUDE, topics.BAROMETER)
+                          topics.IMU, topics.RANGEFINDER, topics.ATTITUDE, topics.BAROMETER,
+                          topics.MOCAP_POSE, topics.INTENT)
               if t in recording.counts]
     by_topic: dict[str, list[tuple[int, Mapping[str, Any]]]] = {t: [] for t in wanted}
     try:
@@ -156,6 +163,7 @@ def load_flight(recording: Recording) -> RecordedFlight:
     try:
         config = params_json.loads(StationConfig, setup.config_json)
         curve = params_json.loads(ThrottleCurve, setup.curve_json)
+        supervisor = params_json.loads(SupervisorParams, setup.supervisor_json)
     except ValueError as exc:
         raise UsageError(f"{name} {topics.SETUP}: unreadable station setup ({exc})") from None
 
@@ -166,6 +174,7 @@ def load_flight(recording: Recording) -> RecordedFlight:
     imus, sonars, atts = (stream(topics.IMU, Imu), stream(topics.RANGEFINDER, Rangefinder),
                           stream(topics.ATTITUDE, Attitude))
     baros = stream(topics.BAROMETER, Barometer)
+    mocaps, intents = stream(topics.MOCAP_POSE, MocapPose), stream(topics.INTENT, Intent)
 
     def take(it: Iterator[Any], n: int, topic: str, k: int) -> tuple[Any, ...]:
         got = tuple(r for _, r in zip(range(n), it, strict=False))
@@ -180,32 +189,36 @@ def load_flight(recording: Recording) -> RecordedFlight:
         frames.append(TickFrame(log_ns, t, take(imus, t.imu_n, topics.IMU, t.tick),
                                 take(sonars, t.rangefinder_n, topics.RANGEFINDER, t.tick),
                                 take(atts, t.attitude_n, topics.ATTITUDE, t.tick),
-                                take(baros, t.baro_n, topics.BAROMETER, t.tick)))
+                                take(baros, t.baro_n, topics.BAROMETER, t.tick),
+                                take(mocaps, t.mocap_n, topics.MOCAP_POSE, t.tick),
+                                take(intents, t.intent_n, topics.INTENT, t.tick)))
     estimates = {ns: _decode(AltEstimate, m, f"{name} {topics.ESTIMATE}")
                  for ns, m in by_topic[topics.ESTIMATE]}
     alts = {ns: _decode(AltControlOutput, m, f"{name} {topics.ALT_CONTROLLER}")
             for ns, m in by_topic.get(topics.ALT_CONTROLLER, [])}
-    return RecordedFlight(config, curve, setup.hover_throttle, tuple(frames), estimates, alts)
+    return RecordedFlight(config, curve, setup.hover_throttle, supervisor, tuple(frames),
+                          estimates, alts)
 
 
 # ------------------------------------------------------------------ the rerun (pure)
 def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunOutputs:
-    """Run fresh estimator and altitude-controller instances over the recorded ticks, exactly as
-    `Station._tick` and `Station._command` drive them (`config`: the recorded one if None)."""
+    """Run a fresh estimator and a fresh supervisor (with its controllers) over the recorded
+    ticks, exactly as `Station._tick` drives them (`config`: the recorded one if None)."""
     cfg = flight.config if config is None else config
     estimator = make_estimator(cfg.estimator_kind.value, cfg.estimator)
     ctrl = AltitudeController(cfg.altitude, flight.curve, flight.hover_throttle)
+    sup = Supervisor(flight.supervisor, ctrl, PositionController(cfg.position),
+                     rest_alt_m=cfg.estimator.rest_alt_m, ground_alt_m=cfg.estimator.ground_alt_m)
     estimates: dict[int, AltEstimate] = {}
     alts: dict[int, AltControlOutput] = {}
     latest_att: Attitude | None = None
-    throttle_us = RcCommand().throttle_us  # the command the station holds, as it starts
-    alt: AltControlOutput | None = None
-    setpoint_m = 0.0
-    engagements = 0
+    latest_pose: MocapPose | None = None
     for frame in flight.ticks:
         t = frame.inputs
         if frame.attitudes:
             latest_att = frame.attitudes[-1]
+        if frame.mocaps:
+            latest_pose = frame.mocaps[-1]
         attitude = frame.attitudes[-1] if frame.attitudes else None
         sonars = frame.sonars
         baro = baro_altitude_m(frame.baros[-1].pressure_pa) if frame.baros else None
@@ -214,30 +227,16 @@ def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunO
         for extra in sonars[1:]:
             est = estimator.update(None, extra, None, t.t_s)
         estimates[frame.log_ns] = est
-        if not t.link_lost:
-            if t.mode is ControlMode.KILLED:
-                throttle_us = STICK_MIN_US
-            elif t.mode is ControlMode.MANUAL:
-                alt = None
-                throttle_us = t.sticks_throttle_us
-            else:
-                roll = latest_att.roll_rad if latest_att is not None else 0.0
-                pitch = latest_att.pitch_rad if latest_att is not None else 0.0
-                if t.engage_count != engagements:
-                    engagements = t.engage_count
-                    on_ground = est.alt_m < cfg.estimator.ground_alt_m
-                    ctrl.engage(est, None if on_ground else throttle_us, roll, pitch)
-                    setpoint_m = est.alt_m
-                target = t.alt_target_m if t.alt_target_m is not None else setpoint_m
-                if t.alt_rate_mps is None:
-                    setpoint_m = target
-                else:
-                    step = t.alt_rate_mps * t.dt_s
-                    setpoint_m += min(max(target - setpoint_m, -step), step)
-                alt = ctrl.update(setpoint_m, est, roll, pitch, t.dt_s)
-                throttle_us = alt.throttle_us
-        if alt is not None:  # the station records its last output on lost and killed ticks too
-            alts[frame.log_ns] = alt
+        sup.step(TickIn(
+            t_s=t.t_s, dt_s=t.dt_s, intents=frame.intents,
+            vehicle=VehicleStatus(seen=t.vehicle_seen, armed=t.armed, mode=t.vehicle_mode,
+                                  heartbeat_t_s=t.heartbeat_t_s, frame_age_s=t.frame_age_s),
+            estimate=est,
+            roll_rad=latest_att.roll_rad if latest_att is not None else 0.0,
+            pitch_rad=latest_att.pitch_rad if latest_att is not None else 0.0,
+            mocap=latest_pose))
+        if sup.alt is not None:  # the station records the last output on held ticks too
+            alts[frame.log_ns] = sup.alt
     return RerunOutputs(estimates, alts)
 
 

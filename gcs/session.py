@@ -15,10 +15,11 @@ from pathlib import Path
 from typing import Any
 
 from firmware_link import LinkError, LinkUsageError, MocapLink, VehicleLink, load_signing_key
-from firmware_link.records import Dialect, MocapPose
+from firmware_link.records import Battery, Dialect, MocapPose
 from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import load_config
 from gcs.errors import UsageError
+from gcs.preflight import PreflightReport, read_and_check
 from gcs.sitl_process import SitlOptions, SitlProcess
 from gcs.station import Station
 from gcs.thrust_curve import ThrottleCurve
@@ -48,6 +49,7 @@ class SessionOptions:
     # a UI in the same process wants it back, so teleop trades a little jitter for it.
     spin_s: float = 0.0015
     metadata: dict[str, Any] = field(default_factory=dict)
+    fix_failsafe: bool = False  # the pilot's consent to set unsafe failsafe parameters
 
     def validate(self) -> None:
         """Reject impossible combinations with one line each."""
@@ -94,6 +96,7 @@ class StationSession:
         )
         self.vehicles: dict[int, Vehicle] = {}
         self.sitl_endpoints: Any = None
+        self.preflight: dict[int, PreflightReport] = {}
         self._stack = contextlib.ExitStack()
 
     def __enter__(self) -> StationSession:
@@ -106,6 +109,20 @@ class StationSession:
 
     def __exit__(self, *exc: object) -> None:
         self._stack.close()
+
+    def _preflight(self, link: VehicleLink, wait_s: float = 2.0) -> PreflightReport:
+        """Read the failsafe, radio and battery facts and judge them (setting the failsafe
+        parameters with the pilot's consent)."""
+        battery_v: float | None = None
+        deadline = self.clock.now_s() + wait_s
+        while battery_v is None and self.clock.now_s() < deadline:
+            for r in link.poll():
+                if isinstance(r, Battery) and r.voltage_v > 0.0:
+                    battery_v = r.voltage_v
+            if battery_v is None:
+                self.clock.sleep_until(self.clock.now_s() + 0.05)
+        return read_and_check(link.get_param, link.set_param, link.dialect, battery_v,
+                              fix=self.options.fix_failsafe)
 
     @property
     def first(self) -> Vehicle:
@@ -172,6 +189,9 @@ class StationSession:
             mocap = MocapFor(mocap_link, sysid)
         station = Station(link, config=config, curve=curve, mocap=mocap, recorder=recorder,
                           clock=self.clock)
+        report = self._preflight(link)
+        self.preflight[sysid] = report
+        station.preflight(report.ok, report.summary())
         # registered last, so it stops first: the loop releases overrides before links close
         self._stack.callback(station.stop)
         return Vehicle(sysid=sysid, url=url, link=link, station=station, recorder=recorder)

@@ -1,34 +1,35 @@
-"""The station: one vehicle link, the estimator and controllers, on a 25 ms loop thread.
+"""The station: one vehicle link, the estimator and the supervisor, on a 25 ms loop thread.
 
-Each tick: poll the link (and the motion-capture link) → altitude estimate → commander (teleop
-sticks, altitude hold, or position hold) → controllers → RC_CHANNELS_OVERRIDE, sent EVERY tick
-(ArduCopter 4.x drops overrides after 3 s of silence and the vehicle falls) → recorder.
+Each tick: poll the link (and motion capture) → altitude estimate → `Supervisor.step` with the
+pilot's intents and what the vehicle said → the messages it decided (arm, disarm, modes) and the
+RC_CHANNELS_OVERRIDE it allows (every tick unless it chose silence) → recorder.
 
-Other threads talk to it only through intents (`request_arm()`, `alt_hold()`, `set_sticks()`,
-...), which are queued and executed on the loop thread, and read it only through `snapshot()`,
-an immutable `StationSnapshot`. When the link is lost the loop keeps running and keeps sending
-the last command (what ArduCopter 3.2.1 would hold anyway, while its own GCS failsafe decides),
-and re-engages the controllers bumplessly when the vehicle speaks again. When the loop ends —
-stop, Ctrl-C or a crash — the overrides are released so the vehicle's own failsafe takes over.
+The station itself decides nothing about safety: it is I/O and scheduling around the pure
+supervisor (gcs.supervisor), whose inputs it records so `replay --rerun` runs the same code.
+Other threads talk to it only through intents (`request_arm()`, `alt_hold()`, `kill()`, ...),
+queued and applied at the next tick, and read it through `snapshot()`.
+
+Stopping while the vehicle may fly lands it first (LAND, confirmed by a heartbeat) and releases
+the overrides only then; a crashed loop does the same on its way out, as far as the link lets it.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import enum
 import queue
 import sys
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from firmware_link.errors import LinkUsageError
 from firmware_link.records import (
     Attitude,
     Barometer,
     CommandAck,
+    Dialect,
     FlightMode,
     Heartbeat,
     Imu,
@@ -42,16 +43,56 @@ from firmware_link.records import (
     TelemetryRecord,
 )
 from gcs import params_json, topics
-from gcs.altitude_controller import AltControlOutput, AltitudeController
+from gcs.altitude_controller import AltitudeController
 from gcs.clock import Clock, MonotonicClock
 from gcs.config import StationConfig
 from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
-from gcs.loop import FixedRateLoop, LoopStats, TickTiming
-from gcs.position_controller import PositionCommand, PositionController, PositionSetpoint
+from gcs.loop import FixedRateLoop, TickTiming
+from gcs.position_controller import PositionController, PositionSetpoint
+from gcs.station_types import (
+    NEVER_S,
+    ControlMode,
+    EventLevel,
+    LoopSample,
+    StationEvent,
+    StationSetup,
+    StationSnapshot,
+    TickInputs,
+)
+from gcs.supervisor import (
+    AIRBORNE_CAPABLE,
+    ActionKind,
+    Intent,
+    IntentKind,
+    LinkHealth,
+    Supervisor,
+    SupervisorOutput,
+    SupervisorParams,
+    SupervisorState,
+    TickIn,
+    VehicleStatus,
+)
 from gcs.thrust_curve import ThrottleCurve
 
-MOCAP_STALE_S = 0.25
+__all__ = [
+    "STICK_MAX_US",
+    "STICK_MIN_US",
+    "ControlMode",
+    "EventLevel",
+    "LoopSample",
+    "Station",
+    "StationEvent",
+    "StationSetup",
+    "StationSnapshot",
+    "TickInputs",
+    "average_imu",
+    "control_mode",
+]
+
 STICK_MIN_US, STICK_MAX_US = 1000, 2000
+LAND_WAIT_STATES = frozenset({SupervisorState.RELEASED, SupervisorState.DISARMED,
+                              SupervisorState.SILENT, SupervisorState.LINK_LOST})
+"""A stopping station may leave once the supervisor is in one of these."""
 
 
 class Recorder(Protocol):
@@ -79,126 +120,13 @@ class LinkLike(Protocol):
     def stats(self) -> Any: ...
 
 
-class ControlMode(enum.Enum):
-    """Who makes the stick command."""
-
-    MANUAL = "manual"  # teleop sticks straight through
-    ALT_HOLD = "alt_hold"  # PC altitude loop on the throttle, teleop on the other sticks
-    POSITION = "position"  # PC altitude loop + mocap position/yaw hold
-    KILLED = "killed"  # throttle to minimum, disarm asked for
-
-
-class EventLevel(enum.IntEnum):
-    """Severity of a station event (foxglove.Log levels)."""
-
-    DEBUG = 1
-    INFO = 2
-    WARNING = 3
-    ERROR = 4
-
-
-@dataclass(frozen=True, slots=True)
-class StationEvent:
-    """Something the pilot should know, with the loop time it happened."""
-
-    t_s: float
-    level: EventLevel
-    text: str
-
-
-@dataclass(frozen=True, slots=True)
-class StationSnapshot:
-    """Everything a display or a script reads, as of one tick."""
-
-    t_s: float
-    tick: int
-    running: bool
-    mode: ControlMode
-    armed: bool
-    vehicle_mode: int  # ArduCopter custom_mode from the last heartbeat (-1 before one)
-    link_lost: bool
-    heartbeat: Heartbeat | None
-    attitude: Attitude | None
-    imu: Imu | None
-    rangefinder: Rangefinder | None
-    mocap: MocapPose | None
-    truth: SimTruth | None
-    latest: dict[type, TelemetryRecord]  # newest record of every type seen (a copy)
-    estimate: AltEstimate | None
-    alt_setpoint_m: float | None
-    position_setpoint: PositionSetpoint | None
-    alt: AltControlOutput | None
-    position: PositionCommand | None
-    command: RcCommand
-    sticks: RcCommand
-    hover_throttle: float
-    loop: LoopStats
-    link_stats: Any
-    events: tuple[StationEvent, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class LoopSample:
-    """/gcs/loop payload: one tick's timing in milliseconds."""
-
-    tick: int
-    period_ms: float
-    jitter_ms: float
-    lateness_ms: float
-    compute_ms: float
-    overrun: bool
-
-
-@dataclass(frozen=True, slots=True)
-class StationSetup:
-    """/gcs/setup payload, once at start: what a rerun needs to rebuild the control stack."""
-
-    config_json: str  # StationConfig as gcs.params_json text (non-finite floats kept)
-    curve_json: str  # ThrottleCurve as gcs.params_json text
-    hover_throttle: float  # the altitude controller's starting hover throttle
-
-
-@dataclass(frozen=True, slots=True)
-class TickInputs:
-    """/gcs/tick payload: what one tick consumed and decided, so a rerun can replay it exactly.
-
-    The `*_n` counts are how many records of each type this tick ingested: the next ones, in
-    recorded order, on their topics."""
-
-    tick: int
-    t_s: float
-    dt_s: float
-    imu_n: int
-    rangefinder_n: int
-    attitude_n: int
-    mocap_n: int
-    link_lost: bool
-    mode: ControlMode
-    engage_count: int  # altitude-controller engagements so far (bumpless take-overs)
-    alt_target_m: float | None
-    alt_rate_mps: float | None
-    sticks_throttle_us: int
-    at_rest: bool = False  # disarmed: the estimator was told the vehicle stands still
-    baro_n: int = 0  # barometer records ingested (the newest one went to the estimator)
-
-
-@dataclass
-class _State:
-    mode: ControlMode = ControlMode.MANUAL
-    sticks: RcCommand = field(default_factory=RcCommand)
-    command: RcCommand = field(default_factory=RcCommand)
-    alt_target_m: float | None = None  # where the setpoint is heading
-    alt_rate_mps: float | None = None  # how fast it moves there (None: controller's profile)
-    alt_setpoint_m: float | None = None
-    pos_setpoint: PositionSetpoint | None = None
-    estimate: AltEstimate | None = None
-    at_rest: bool = False
-    alt: AltControlOutput | None = None
-    position: PositionCommand | None = None
-    engaged: bool = False
-    was_lost: bool = False
-    mocap_ok: bool = False
-    engage_count: int = 0
+def control_mode(state: SupervisorState, position: bool) -> ControlMode:
+    """The display's view of who makes the throttle."""
+    if state is SupervisorState.KILLED:
+        return ControlMode.KILLED
+    if state in (SupervisorState.SPOOL_UP, SupervisorState.TAKEOFF, SupervisorState.HOLD):
+        return ControlMode.POSITION if position else ControlMode.ALT_HOLD
+    return ControlMode.MANUAL
 
 
 class Station:
@@ -214,6 +142,7 @@ class Station:
         mocap: Any = None,
         recorder: Recorder | None = None,
         clock: Clock | None = None,
+        supervisor: SupervisorParams | None = None,
     ) -> None:
         self.config = config or StationConfig()
         self.link = link
@@ -221,27 +150,38 @@ class Station:
         self.recorder = recorder
         self.clock = clock or MonotonicClock()
         self.curve = curve or ThrottleCurve()
+        dialect = getattr(link, "dialect", Dialect.UNKNOWN)
+        self.supervisor_params = supervisor or SupervisorParams.for_dialect(
+            dialect if isinstance(dialect, Dialect) else Dialect.UNKNOWN)
         self.estimator = make_estimator(self.config.estimator_kind.value, self.config.estimator)
         self.alt_ctrl = AltitudeController(self.config.altitude, self.curve, hover_throttle)
         self.pos_ctrl = PositionController(self.config.position)
+        est = self.config.estimator
+        self.supervisor = Supervisor(self.supervisor_params, self.alt_ctrl, self.pos_ctrl,
+                                     rest_alt_m=est.rest_alt_m, ground_alt_m=est.ground_alt_m)
         self.loop = FixedRateLoop(self.clock, self.config.period_s, self._tick,
                                   realtime_priority=self.config.realtime_priority)
-        self._intents: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._intents: queue.SimpleQueue[Intent] = queue.SimpleQueue()
         self._lock = threading.Lock()
         self._events: deque[StationEvent] = deque(maxlen=self.config.events_kept)
         self._latest: dict[type, TelemetryRecord] = {}
-        self._s = _State()
         self._thread: threading.Thread | None = None
         self._running = False
         self._error: BaseException | None = None
         self._listeners: list[Callable[[StationSnapshot], None]] = []
         self._record_listeners: list[Callable[[TelemetryRecord], None]] = []
+        self._listener_errors = 0
+        self._last_rx_s = -NEVER_S
+        self._heartbeats_on = True
+        self._estimate: AltEstimate | None = None
+        self._out: SupervisorOutput | None = None
+        self._link_down_s = 0.0
         self._empty_stats = self.loop.stats()
         self._snapshot = self._make_snapshot(self.clock.now_s(), -1)
         if recorder is not None:
             recorder.put(topics.SETUP, self.clock.now_s(), StationSetup(
                 params_json.dumps(self.config), params_json.dumps(self.curve),
-                self.alt_ctrl.hover_throttle))
+                self.alt_ctrl.hover_throttle, params_json.dumps(self.supervisor_params)))
 
     # ------------------------------------------------------------------ lifecycle
     def start(self) -> None:
@@ -255,7 +195,15 @@ class Station:
         self._thread.start()
 
     def stop(self, timeout_s: float = 2.0) -> None:
-        """Stop the loop and wait for it; overrides are released on the way out."""
+        """Stop the loop. A vehicle that may be flying is landed first (LAND confirmed by a
+        heartbeat, at most the supervisor's quit timeout); overrides are released only then."""
+        alive = self._running and self._thread is not None and self._thread.is_alive()
+        flying = self.snapshot(loop_stats=False).state in AIRBORNE_CAPABLE | {
+            SupervisorState.KILLED}
+        if alive and flying:
+            self._intents.put(Intent(IntentKind.QUIT))
+            self.wait_for(lambda s: s.state in LAND_WAIT_STATES,
+                          self.supervisor_params.quit_timeout_s)
         self.loop.stop()
         if self._thread is not None:
             self._thread.join(timeout_s)
@@ -278,7 +226,8 @@ class Station:
         return self._running
 
     def add_listener(self, fn: Callable[[StationSnapshot], None]) -> None:
-        """Call `fn(snapshot)` on the loop thread after every tick (keep it cheap)."""
+        """Call `fn(snapshot)` on the loop thread after every tick (keep it cheap). An exception
+        in it is counted and logged, never fatal to the loop."""
         self._listeners.append(fn)
 
     def add_record_listener(self, fn: Callable[[TelemetryRecord], None]) -> None:
@@ -299,105 +248,100 @@ class Station:
             self._error = exc
             self._event(self.clock.now_s(), EventLevel.ERROR,
                         f"control loop stopped: {type(exc).__name__}: {exc}")
+            self._emergency_land()
         finally:
+            self._let_go()
+            self._running = False
+            with self._lock:
+                self._snapshot = self._make_snapshot(self.clock.now_s(), self._snapshot.tick)
+
+    def _let_go(self) -> None:
+        """Release the overrides only where that cannot drop a flying vehicle."""
+        state = self.supervisor.state
+        hb = self._latest.get(Heartbeat)
+        disarmed = isinstance(hb, Heartbeat) and not hb.armed
+        landing = isinstance(hb, Heartbeat) and hb.mode == FlightMode.LAND
+        if state in (SupervisorState.RELEASED, SupervisorState.DISARMED) or disarmed or landing:
             try:
                 self.link.release_overrides()
             except Exception as exc:  # the link may be what failed; the vehicle's failsafe rules
                 self._event(self.clock.now_s(), EventLevel.ERROR,
                             f"could not release overrides: {exc}")
-            self._running = False
-            with self._lock:
-                self._snapshot = self._make_snapshot(self.clock.now_s(), self._snapshot.tick)
+        elif state is not SupervisorState.SILENT:
+            self._event(self.clock.now_s(), EventLevel.ERROR,
+                        f"left the vehicle armed in {state.value}: overrides not released, the "
+                        "vehicle's own failsafe takes over")
+
+    def _emergency_land(self, seconds: float = 3.0) -> None:
+        """The loop crashed: ask for LAND (hover throttle, level) until a heartbeat shows it."""
+        if self.supervisor.state not in AIRBORNE_CAPABLE:
+            return
+        hover = RcCommand(1500, 1500, self.alt_ctrl.hover_stick_us(), 1500)
+        end = time.monotonic() + seconds
+        next_mode = 0.0
+        try:
+            while time.monotonic() < end:
+                for r in self.link.poll():
+                    if isinstance(r, Heartbeat):
+                        self._latest[Heartbeat] = r
+                hb = self._latest.get(Heartbeat)
+                if isinstance(hb, Heartbeat) and (not hb.armed or hb.mode == FlightMode.LAND):
+                    return
+                if time.monotonic() >= next_mode:
+                    self.link.send_set_mode(FlightMode.LAND)
+                    next_mode = time.monotonic() + 0.5
+                self.link.rc_override(hover)
+                time.sleep(self.config.period_s)  # a dead loop paces itself: no clock to wait on
+        except Exception as exc:
+            self._event(self.clock.now_s(), EventLevel.ERROR, f"emergency LAND failed: {exc}")
 
     # ------------------------------------------------------------------ intents (any thread)
-    def _intent(self, fn: Callable[[], None]) -> None:
-        self._intents.put(fn)
+    def _intent(self, intent: Intent) -> None:
+        self._intents.put(intent)
 
     def request_arm(self, force: bool = False) -> None:
-        """Ask the vehicle to arm (outcome: Heartbeat.armed, CommandAck, events)."""
-        self._intent(lambda: self._send(lambda: self.link.send_arm(force), "arm requested"))
+        """Ask the vehicle to arm (refused by the supervisor until pre-flight checks pass)."""
+        self._intent(Intent(IntentKind.ARM))
 
     def request_disarm(self, force: bool = False) -> None:
         """Ask the vehicle to disarm."""
-        self._intent(lambda: self._send(lambda: self.link.send_disarm(force), "disarm requested"))
+        self._intent(Intent(IntentKind.DISARM))
 
     def set_mode(self, mode: FlightMode) -> None:
         """Ask the vehicle for a flight mode (SET_MODE)."""
-        self._intent(lambda: self._send(lambda: self.link.send_set_mode(mode),
-                                        f"mode {mode.name} requested"))
+        self._intent(Intent(IntentKind.SET_MODE, mode=int(mode)))
 
     def set_sticks(self, roll_us: int, pitch_us: int, yaw_us: int, throttle_us: int) -> None:
-        """Teleop sticks (µs); the throttle is used only in MANUAL mode."""
-        sticks = RcCommand(roll_us=_clamp_us(roll_us), pitch_us=_clamp_us(pitch_us),
-                           throttle_us=_clamp_us(throttle_us), yaw_us=_clamp_us(yaw_us))
-
-        def apply() -> None:
-            self._s.sticks = sticks
-
-        self._intent(apply)
+        """Teleop sticks (µs); the throttle is used only under the pilot's control."""
+        self._intent(Intent(IntentKind.STICKS, roll_us=_clamp_us(roll_us),
+                            pitch_us=_clamp_us(pitch_us), throttle_us=_clamp_us(throttle_us),
+                            yaw_us=_clamp_us(yaw_us)))
 
     def alt_hold(self, on: bool, setpoint_m: float | None = None,
                  rate_mps: float | None = None) -> None:
-        """Engage (or leave) PC altitude hold. The setpoint moves to `setpoint_m` at `rate_mps`
-        (None: the controller's own profile); None keeps the present altitude."""
-
-        def apply() -> None:
-            s = self._s
-            if not on:
-                if s.mode in (ControlMode.ALT_HOLD, ControlMode.POSITION):
-                    s.mode = ControlMode.MANUAL
-                    self._event(self.clock.now_s(), EventLevel.INFO, "altitude hold off")
-                return
-            if s.mode is ControlMode.KILLED:
-                return
-            if s.mode is ControlMode.MANUAL:
-                s.mode = ControlMode.ALT_HOLD
-                s.engaged = False
-            s.alt_target_m = setpoint_m
-            s.alt_rate_mps = rate_mps
-            self._event(self.clock.now_s(), EventLevel.INFO,
-                        "altitude hold on" + (f", setpoint {setpoint_m:.2f} m"
-                                              if setpoint_m is not None else ""))
-
-        self._intent(apply)
+        """Engage PC altitude hold (taking off if on the floor) or leave it. The setpoint moves
+        to `setpoint_m` at `rate_mps` (None: the controller's own profile); None keeps the
+        present altitude."""
+        self._intent(Intent(IntentKind.ALT_HOLD, setpoint_m=setpoint_m, rate_mps=rate_mps)
+                     if on else Intent(IntentKind.ALT_HOLD_OFF))
 
     def set_position_setpoint(self, setpoint: PositionSetpoint | None) -> None:
-        """Hold a mocap position (engages altitude hold too); None returns to ALT_HOLD."""
-
-        def apply() -> None:
-            s = self._s
-            if s.mode is ControlMode.KILLED:
-                return
-            s.pos_setpoint = setpoint
-            if setpoint is None:
-                if s.mode is ControlMode.POSITION:
-                    s.mode = ControlMode.ALT_HOLD
-                return
-            if s.mode is ControlMode.MANUAL:
-                s.engaged = False
-            if s.mode is not ControlMode.POSITION:
-                self.pos_ctrl.reset()
-            s.mode = ControlMode.POSITION
-
-        self._intent(apply)
+        """Hold a mocap position while the altitude is held; None: level sticks from the pilot."""
+        self._intent(Intent(IntentKind.POSITION_OFF) if setpoint is None else Intent(
+            IntentKind.POSITION, north_m=setpoint.north_m, east_m=setpoint.east_m,
+            yaw_rad=setpoint.yaw_rad))
 
     def kill(self) -> None:
-        """Throttle to minimum at once and disarm (forced where the firmware can)."""
+        """Throttle to minimum from the next tick and disarm until a heartbeat says disarmed."""
+        self._intent(Intent(IntentKind.KILL))
 
-        def apply() -> None:
-            self._s.mode = ControlMode.KILLED
-            self._event(self.clock.now_s(), EventLevel.WARNING, "KILL: throttle minimum, disarm")
-            try:
-                self.link.send_disarm(True)
-            except Exception:  # APM 2.5 has no force-disarm; a normal disarm is the next best
-                self.link.send_disarm(False)
+    def quit(self) -> None:
+        """Land if flying (LAND confirmed by a heartbeat), then release the overrides."""
+        self._intent(Intent(IntentKind.QUIT))
 
-        self._intent(apply)
-
-    def _send(self, fn: Callable[[], bool], text: str) -> None:
-        ok = fn()
-        self._event(self.clock.now_s(), EventLevel.INFO if ok else EventLevel.WARNING,
-                    text if ok else f"{text}, but the link is down")
+    def preflight(self, ok: bool, note: str) -> None:
+        """The pre-flight checks' verdict: arming is refused until one says ok."""
+        self._intent(Intent(IntentKind.PREFLIGHT, ok=ok, note=note))
 
     # ------------------------------------------------------------------ reading (any thread)
     def snapshot(self, loop_stats: bool = True) -> StationSnapshot:
@@ -429,44 +373,84 @@ class Station:
             self.recorder.put(topics.EVENTS, t_s, ev)
 
     def _tick(self, k: int, t_s: float, dt_s: float) -> None:
+        intents: list[Intent] = []
         while True:
             try:
-                self._intents.get_nowait()()
+                intents.append(self._intents.get_nowait())
             except queue.Empty:
                 break
         records = self.link.poll()
+        for r in records:
+            if not isinstance(r, LinkEvent):
+                self._last_rx_s = max(self._last_rx_s, r.t_s)
         if self.mocap is not None:
             records = records + list(self.mocap.poll())
         imu, sonars, attitude, baro = self._ingest(records)
-        s = self._s
-        lost = self.link.lost
         hb = self._latest.get(Heartbeat)
+        hb = hb if isinstance(hb, Heartbeat) else None
+        status = VehicleStatus(
+            seen=hb is not None, armed=bool(hb and hb.armed), mode=hb.mode if hb else -1,
+            heartbeat_t_s=hb.t_s if hb else -NEVER_S,
+            frame_age_s=min(NEVER_S, t_s - self._last_rx_s))
         # disarmed, the motors are stopped: the vehicle stands still (the estimator checks it
         # is on the floor); before the first heartbeat nothing is known
-        s.at_rest = isinstance(hb, Heartbeat) and not hb.armed and not lost
+        at_rest = (status.seen and not status.armed
+                   and status.frame_age_s <= self.supervisor_params.lost_after_s)
         est = self.estimator.update(
-            imu, sonars[0] if sonars else None, attitude, t_s, at_rest=s.at_rest,
+            imu, sonars[0] if sonars else None, attitude, t_s, at_rest=at_rest,
             baro_alt_m=None if baro is None else baro_altitude_m(baro.pressure_pa))
         for extra in sonars[1:]:
             est = self.estimator.update(None, extra, None, t_s)
-        s.estimate = est
-        if lost and not s.was_lost:
-            self._event(t_s, EventLevel.ERROR,
-                        "vehicle link LOST: holding the last command; the vehicle's failsafe "
-                        "decides until it speaks again")
-        elif s.was_lost and not lost:
-            self._event(t_s, EventLevel.WARNING, "vehicle link regained")
-            s.engaged = False  # re-engage bumplessly from the held command
-        s.was_lost = lost
-        if not lost:
-            s.command = self._command(t_s, dt_s, est)
-        self.link.rc_override(s.command)
-        self._record_tick(t_s, k, est, dt_s, records)
+        self._estimate = est
+        att = self._latest.get(Attitude)
+        pose = self._latest.get(MocapPose)
+        out = self.supervisor.step(TickIn(
+            t_s=t_s, dt_s=dt_s, intents=tuple(intents), vehicle=status, estimate=est,
+            roll_rad=att.roll_rad if isinstance(att, Attitude) else 0.0,
+            pitch_rad=att.pitch_rad if isinstance(att, Attitude) else 0.0,
+            mocap=pose if isinstance(pose, MocapPose) else None))
+        self._out = out
+        if out.link is LinkHealth.LOST:
+            self._link_down_s += dt_s
+        self._execute(t_s, out)
+        self._record_tick(t_s, k, dt_s, est, records, intents, status, out, at_rest)
         snap = self._make_snapshot(t_s, k)
         with self._lock:
             self._snapshot = snap
         for fn in self._listeners:
-            fn(snap)
+            try:
+                fn(snap)
+            except Exception as exc:  # a display or a script must never stop flight control
+                self._listener_errors += 1
+                if self._listener_errors == 1 or self._listener_errors % 100 == 0:
+                    self._event(t_s, EventLevel.ERROR, f"listener failed "
+                                f"({self._listener_errors} so far): {type(exc).__name__}: {exc}")
+
+    def _execute(self, t_s: float, out: SupervisorOutput) -> None:
+        link = self.link
+        for a in out.actions:
+            if a.kind is ActionKind.ARM:
+                link.send_arm(False)
+            elif a.kind is ActionKind.DISARM:
+                link.send_disarm(False)
+            elif a.kind is ActionKind.FORCE_DISARM:
+                try:
+                    link.send_disarm(True)
+                except LinkUsageError:  # the firmware turned out to have no force
+                    link.send_disarm(False)
+            elif a.kind is ActionKind.SET_MODE:
+                link.send_set_mode(a.mode)
+            elif a.kind is ActionKind.RELEASE:
+                link.release_overrides()
+        if out.heartbeat != self._heartbeats_on:
+            self._heartbeats_on = out.heartbeat
+            set_hb = getattr(link, "set_gcs_heartbeat", None)
+            if set_hb is not None:
+                set_hb(out.heartbeat)
+        if out.command is not None:
+            link.rc_override(out.command)
+        for note in out.notes:
+            self._event(t_s, EventLevel(int(note.level)), note.text)
 
     def _ingest(self, records: list[TelemetryRecord]) -> tuple[
             Imu | None, list[Rangefinder], Attitude | None, Barometer | None]:
@@ -478,7 +462,12 @@ class Station:
         for r in records:
             self._latest[type(r)] = r
             for fn in self._record_listeners:
-                fn(r)
+                try:
+                    fn(r)
+                except Exception as exc:
+                    self._listener_errors += 1
+                    if self._listener_errors == 1 or self._listener_errors % 100 == 0:
+                        self._event(r.t_s, EventLevel.ERROR, f"record listener failed: {exc}")
             if rec is not None:
                 topic = topics.topic_for(r)
                 if topic is not None:
@@ -502,57 +491,14 @@ class Station:
                             f"vehicle: {r.text}")
         return average_imu(imus), sonars, attitude, baro
 
-    def _command(self, t_s: float, dt_s: float, est: AltEstimate) -> RcCommand:
-        s = self._s
-        sticks = s.sticks
-        if s.mode is ControlMode.KILLED:
-            return RcCommand(1500, 1500, STICK_MIN_US, 1500)
-        if s.mode is ControlMode.MANUAL:
-            s.alt = None
-            s.position = None
-            return sticks
-        att = self._latest.get(Attitude)
-        roll = att.roll_rad if isinstance(att, Attitude) else 0.0
-        pitch = att.pitch_rad if isinstance(att, Attitude) else 0.0
-        if not s.engaged:
-            on_ground = est.alt_m < self.config.estimator.ground_alt_m
-            # from the floor start at hover (I = 0); in the air take over the present throttle
-            self.alt_ctrl.engage(est, None if on_ground else s.command.throttle_us, roll, pitch)
-            s.alt_setpoint_m = est.alt_m
-            s.engaged = True
-            s.engage_count += 1
-        target = s.alt_target_m if s.alt_target_m is not None else s.alt_setpoint_m
-        assert s.alt_setpoint_m is not None and target is not None
-        if s.alt_rate_mps is None:
-            s.alt_setpoint_m = target
-        else:
-            step = s.alt_rate_mps * dt_s
-            s.alt_setpoint_m += min(max(target - s.alt_setpoint_m, -step), step)
-        s.alt = self.alt_ctrl.update(s.alt_setpoint_m, est, roll, pitch, dt_s)
-        roll_us, pitch_us, yaw_us = sticks.roll_us, sticks.pitch_us, sticks.yaw_us
-        s.position = None
-        if s.mode is ControlMode.POSITION and s.pos_setpoint is not None:
-            pose = self._latest.get(MocapPose)
-            fresh = isinstance(pose, MocapPose) and t_s - pose.t_s <= MOCAP_STALE_S
-            if fresh and isinstance(pose, MocapPose):
-                s.position = self.pos_ctrl.update(s.pos_setpoint, pose, dt_s)
-                roll_us, pitch_us, yaw_us = (s.position.roll_us, s.position.pitch_us,
-                                             s.position.yaw_us)
-            else:
-                roll_us, pitch_us, yaw_us = 1500, 1500, 1500  # level, no yaw: drift, don't chase
-            if fresh != s.mocap_ok:
-                self._event(t_s, EventLevel.INFO if fresh else EventLevel.WARNING,
-                            "motion capture " + ("tracking" if fresh else "lost: holding level"))
-                s.mocap_ok = fresh
-        return RcCommand(roll_us=roll_us, pitch_us=pitch_us, throttle_us=s.alt.throttle_us,
-                         yaw_us=yaw_us)
-
-    def _record_tick(self, t_s: float, k: int, est: AltEstimate, dt_s: float,
-                     records: list[TelemetryRecord]) -> None:
+    def _record_tick(self, t_s: float, k: int, dt_s: float, est: AltEstimate,
+                     records: list[TelemetryRecord], intents: list[Intent],
+                     status: VehicleStatus, out: SupervisorOutput, at_rest: bool) -> None:
         rec = self.recorder
         if rec is None:
             return
-        s = self._s
+        for it in intents:
+            rec.put(topics.INTENT, t_s, it)
         rec.put(topics.TICK, t_s, TickInputs(
             tick=k, t_s=t_s, dt_s=dt_s,
             imu_n=sum(isinstance(r, Imu) for r in records),
@@ -560,15 +506,20 @@ class Station:
             attitude_n=sum(isinstance(r, Attitude) for r in records),
             mocap_n=sum(isinstance(r, MocapPose) for r in records),
             baro_n=sum(isinstance(r, Barometer) for r in records),
-            link_lost=s.was_lost, mode=s.mode, engage_count=s.engage_count,
-            alt_target_m=s.alt_target_m, alt_rate_mps=s.alt_rate_mps,
-            sticks_throttle_us=s.sticks.throttle_us, at_rest=s.at_rest))
+            intent_n=len(intents), at_rest=at_rest, vehicle_seen=status.seen,
+            armed=status.armed, vehicle_mode=status.mode, heartbeat_t_s=status.heartbeat_t_s,
+            frame_age_s=status.frame_age_s, state=out.state,
+            link_lost=out.link is LinkHealth.LOST))
+        for tr in out.transitions:
+            rec.put(topics.SUPERVISOR, t_s, tr)
         rec.put(topics.ESTIMATE, t_s, est)
-        if s.alt is not None:
-            rec.put(topics.ALT_CONTROLLER, t_s, s.alt)
-        if s.position is not None:
-            rec.put(topics.POSITION_CONTROLLER, t_s, s.position)
-        rec.put(topics.RC_OVERRIDE, t_s, s.command)
+        sup = self.supervisor
+        if sup.alt is not None:
+            rec.put(topics.ALT_CONTROLLER, t_s, sup.alt)
+        if sup.position is not None:
+            rec.put(topics.POSITION_CONTROLLER, t_s, sup.position)
+        if out.command is not None:
+            rec.put(topics.RC_OVERRIDE, t_s, out.command)
         last: TickTiming | None = self.loop.last_timing
         if last is not None:
             rec.put(topics.LOOP, t_s, LoopSample(
@@ -577,10 +528,11 @@ class Station:
                 overrun=last.overrun))
 
     def _make_snapshot(self, t_s: float, k: int) -> StationSnapshot:
-        s = self._s
+        sup = self.supervisor
         latest = dict(self._latest)
         hb = latest.get(Heartbeat)
         hb = hb if isinstance(hb, Heartbeat) else None
+        out = self._out
 
         def get(cls: type) -> Any:
             r = latest.get(cls)
@@ -590,10 +542,12 @@ class Station:
             t_s=t_s,
             tick=k,
             running=self._running,
-            mode=s.mode,
+            mode=control_mode(sup.state, sup.pos_setpoint is not None),
+            state=sup.state,
+            link_health=out.link if out is not None else LinkHealth.OK,
             armed=bool(hb and hb.armed),
             vehicle_mode=hb.mode if hb else -1,
-            link_lost=bool(getattr(self.link, "lost", False)),
+            link_lost=out is not None and out.link is LinkHealth.LOST,
             heartbeat=hb,
             attitude=get(Attitude),
             imu=get(Imu),
@@ -601,17 +555,20 @@ class Station:
             mocap=get(MocapPose),
             truth=get(SimTruth),
             latest=latest,
-            estimate=s.estimate,
-            alt_setpoint_m=s.alt_setpoint_m if s.mode is not ControlMode.MANUAL else None,
-            position_setpoint=s.pos_setpoint if s.mode is ControlMode.POSITION else None,
-            alt=s.alt,
-            position=s.position,
-            command=s.command,
-            sticks=s.sticks,
+            estimate=self._estimate,
+            alt_setpoint_m=out.alt_setpoint_m if out is not None else None,
+            position_setpoint=sup.pos_setpoint if sup.state is SupervisorState.HOLD else None,
+            alt=sup.alt,
+            position=sup.position,
+            command=sup.command,
+            sticks=sup.sticks,
+            throttle_gate_us=out.throttle_gate_us if out is not None else None,
             hover_throttle=self.alt_ctrl.hover_throttle,
             loop=self._empty_stats if k < 0 else self._snapshot.loop,
             link_stats=self.link.stats,
             events=tuple(self._events),
+            listener_errors=self._listener_errors,
+            link_down_s=self._link_down_s,
         )
 
 

@@ -30,6 +30,8 @@ LOOP = "/gcs/loop"
 EVENTS = "/gcs/events"
 TICK = "/gcs/tick"  # what each tick consumed and decided (for an exact rerun)
 SETUP = "/gcs/setup"  # the station's configuration and throttle curve, once at start
+INTENT = "/gcs/intent"  # every pilot/script intent, with the tick that applied it
+SUPERVISOR = "/gcs/supervisor"  # the supervisor's changes of state and their reasons
 
 RECORD_TOPICS: dict[type, str] = {
     r.Heartbeat: HEARTBEAT,

@@ -26,6 +26,10 @@ def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
                    help="record the flight to MCAP (default on)")
     p.add_argument("-o", "--output", type=Path, default=Path("flights"),
                    help="recording file or directory (default flights/)")
+    p.add_argument("--fix-failsafe", action="store_true",
+                   help="let the station set the vehicle's GCS failsafe parameters when the "
+                        "pre-flight checks find them unsafe (FS_GCS_ENABLE, FS_GCS_TIMEOUT); "
+                        "without it such a vehicle is refused")
 
 
 def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
@@ -34,5 +38,5 @@ def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
         command=command, connect=args.connect, mocap=args.mocap, profile=args.profile,
         world=args.world, serial=args.serial, speedup=getattr(args, "speedup", 1.0),
         seed=args.seed, config=args.config, signing_key=args.signing_key, record=args.record,
-        output=args.output,
+        output=args.output, fix_failsafe=getattr(args, "fix_failsafe", False),
     )

@@ -7,15 +7,17 @@ With no `--connect` it starts the bundled SITL and flies that. `--json` prints o
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
+import signal
 import sys
 from typing import Any
 
 from firmware_link.records import Dialect
 from gcs.clock import Clock
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
-from gcs.errors import UsageError
+from gcs.errors import FlightFailed, UsageError
 from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
 from gcs.session import StationSession
 from gcs.station import StationSnapshot
@@ -32,14 +34,21 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="after the hold, step the setpoint by this many m and score it")
     p.add_argument("--speedup", type=float, default=1.0,
                    help="run the bundled SITL and the loop this many times faster (default 1)")
+    p.add_argument("--takeoff-delay", type=float, default=0.0, metavar="S",
+                   help="stay armed on the floor this long before taking off (default 0)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--live", action="store_true", help="print telemetry lines while flying")
     p.set_defaults(func=run)
 
 
+ABSURD_RMS_M = 0.5
+"""A hold error beyond this is a vehicle that did not do what it was told."""
+
+
 def _plan(args: argparse.Namespace) -> FlightPlan:
     try:
-        return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step)
+        return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step,
+                          takeoff_delay_s=args.takeoff_delay)
     except ValueError as exc:
         raise UsageError(f"--alt/--hold/--step: {exc}") from None
 
@@ -117,31 +126,52 @@ def _print_summary(d: dict[str, Any]) -> None:
     print(f"recording: {d['recording'] or 'off'}")
 
 
+def _on_sigterm(signum: int, frame: object) -> None:
+    # a terminated flight unwinds like Ctrl-C: the session lands the vehicle before letting go
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
 def fly(args: argparse.Namespace) -> dict[str, Any]:
-    """Run the whole flight; return the summary dict (the CLI prints it)."""
+    """Run the whole flight; return the summary dict (the CLI prints it). FlightFailed (exit 3)
+    when the flight did not go as commanded; leaving the session lands a flying vehicle."""
     plan = _plan(args)
     if args.speedup != 1.0 and args.connect is not None:
         raise UsageError("--speedup applies to the bundled SITL only; a vehicle at --connect "
                          "flies in real time")
     options = session_options(args, "fly")
+    with contextlib.suppress(ValueError):  # not the main thread (tests): no handler needed
+        signal.signal(signal.SIGTERM, _on_sigterm)
     with StationSession(options) as session:
         v = session.first
         v.station.start()
         printer = LivePrinter(session.clock) if args.live else None
         runner = FlightRunner(v.station, plan, printer)
+        path = str(v.recorder.path) if v.recorder is not None else None
         try:
             runner.fly()
-        except BaseException:
-            # leave the vehicle to its own failsafe with the throttle at minimum, not mid-air
-            v.station.kill()
-            raise
-        path = str(v.recorder.path) if v.recorder is not None else None
-        return _summary_dict(runner.summary(), path, v.link.dialect)
+        except FlightFailed as exc:
+            snap = v.station.snapshot(loop_stats=False)
+            raise FlightFailed(f"{exc}; link down {snap.link_down_s:.1f} s; recording "
+                               f"{path or 'off'}") from None
+        d = _summary_dict(runner.summary(), path, v.link.dialect)
+        d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
+        rms = d.get("rms_error_m")
+        if not isinstance(rms, float) or not math.isfinite(rms) or rms > ABSURD_RMS_M:
+            raise FlightFailed(f"hold error {rms} m is not a flight that went as commanded "
+                               f"(over {ABSURD_RMS_M} m or unknown); recording {path or 'off'}")
+        return d
 
 
 def run(args: argparse.Namespace) -> int:
     """CLI entry: fly, then print the summary (text or JSON)."""
-    d = fly(args)
+    try:
+        d = fly(args)
+    except FlightFailed as exc:
+        if args.json:
+            json.dump({"status": "failed", "reason": str(exc)}, sys.stdout)
+            print()
+        raise
+    d["status"] = "ok"
     if args.json:
         json.dump(d, sys.stdout)
         print()

@@ -64,17 +64,19 @@ def _ticks(st: Station, seconds: float) -> None:
 
 @pytest.fixture(scope="module")
 def flight(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Arm, climb on a ramp, lose and regain the link, hand back to the sticks in the air,
-    re-engage there, then kill: every path of the station's commander."""
+    """Arm, take off on the ramp, a short telemetry gap (held, then resumed), hand back to the
+    sticks in the air, re-engage there, a long loss (LAND, silence, the link back), then kill:
+    every path of the supervisor."""
     path = tmp_path_factory.mktemp("rerun") / "flight.mcap"
     clock = SimClock(1000.0)
     board = NoisyBoard(clock, np.random.default_rng(7))
     with Recorder(path, metadata={"command": "test"}) as rec:
         st = Station(board, clock=clock, recorder=rec, curve=board.curve)
+        st.preflight(True, "test board")
         st.request_arm()
-        _ticks(st, 0.5)
+        _ticks(st, 1.2)
         st.alt_hold(True, 1.0, rate_mps=0.5)
-        _ticks(st, 6.0)
+        _ticks(st, 8.0)
         board.lost = True
         _ticks(st, 0.5)
         board.lost = False
@@ -84,6 +86,10 @@ def flight(tmp_path_factory: pytest.TempPathFactory) -> Path:
         _ticks(st, 0.5)
         st.alt_hold(True, 0.8)
         _ticks(st, 3.0)
+        board.lost = True
+        _ticks(st, 5.0)
+        board.lost = False
+        _ticks(st, 1.5)
         st.kill()
         _ticks(st, 0.3)
     return path
@@ -101,9 +107,12 @@ def test_the_recording_says_what_each_tick_consumed(flight: Path) -> None:
     assert len(ticks) == rec.counts[topics.ESTIMATE]
     assert sum(t["imu_n"] for t in ticks) == rec.counts[topics.IMU]
     assert sum(t["rangefinder_n"] for t in ticks) == rec.counts[topics.RANGEFINDER]
-    assert max(t["engage_count"] for t in ticks) == 3  # take-off, link regained, re-engaged
-    assert {t["mode"] for t in ticks} == {"manual", "alt_hold", "killed"}
+    states = {t["state"] for t in ticks}
+    assert {"arming", "manual", "takeoff", "hold", "link_lost", "silent",
+            "killed"} <= states
     assert any(t["link_lost"] for t in ticks)
+    assert sum(t["intent_n"] for t in ticks) == rec.counts[topics.INTENT]
+    assert rec.counts[topics.SUPERVISOR] >= 8
     assert rec.counts[topics.SETUP] == 1
 
 
@@ -224,10 +233,11 @@ def test_recordings_that_cannot_be_rerun(tmp_path: Path,
     short = tmp_path / "short.mcap"
     st = Station(FakeBoard(SimClock()), clock=SimClock())
     with Recorder(short, metadata={}) as rec:
-        setup = StationSetup(params_json.dumps(st.config), params_json.dumps(st.curve), 0.5)
+        setup = StationSetup(params_json.dumps(st.config), params_json.dumps(st.curve), 0.5,
+                             params_json.dumps(st.supervisor_params))
         rec.put(topics.SETUP, 1.0, setup)
-        rec.put(topics.TICK, 1.0, TickInputs(0, 1.0, 0.025, 3, 0, 0, 0, False,
-                                             st.snapshot().mode, 0, None, None, 1000))
+        rec.put(topics.TICK, 1.0, TickInputs(0, 1.0, 0.025, 3, 0, 0, 0, 0, 0, False, True,
+                                             False, 0, 1.0, 0.0, st.snapshot().state, False))
         rec.put(topics.ESTIMATE, 1.0, {"alt_m": 0.0})
     with pytest.raises(UsageError, match="ran out of"):
         load_flight(open_recording(short))

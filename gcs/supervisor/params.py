@@ -1,0 +1,74 @@
+"""The supervisor's tuning and the per-firmware facts its policy depends on.
+
+Link-loss policy (the same decision in both dialects; what differs is how the firmware then
+behaves, which the pre-flight checks make safe):
+
+- Proof of life is any frame from the vehicle. A gap over `degraded_after_s` holds a safe
+  command (hover throttle, level) and freezes the altitude controller; the controller resumes
+  when frames come back.
+- A gap over `lost_after_s` lands the vehicle: SET_MODE LAND every `mode_resend_s` for
+  `land_request_s` while the uplink may still work, with the hover throttle in the overrides.
+- Still nothing heard after that: the station goes silent (no overrides, no heartbeats), so the
+  autopilot's own GCS failsafe fires whatever the state of the uplink. ArduCopter 3.2.1 fires it
+  5 s after the last heartbeat or override (and its radio failsafe 2 s after the last override
+  when no receiver is fitted); 4.x after FS_GCS_TIMEOUT, which the pre-flight checks require to be
+  shorter than RC_OVERRIDE_TIME, so the GCS failsafe lands it before the overrides lapse.
+- When the link returns nothing resumes: a vehicle in LAND is left landing, a disarmed one stays
+  disarmed, one still in STABILIZE keeps being asked to LAND. The pilot re-engages.
+- Motion capture is not used to keep flying through a loss: it tells where the vehicle is, not
+  whether it is armed, in which mode, or whether the station's commands arrive.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from firmware_link.records import Dialect
+
+
+@dataclass(frozen=True, slots=True)
+class SupervisorParams:
+    """Timings in seconds of the station clock, PWM in µs."""
+
+    degraded_after_s: float = 0.3  # 12 ticks of 40 Hz telemetry missing
+    lost_after_s: float = 1.0
+    land_request_s: float = 3.0  # LAND commanded this long before going silent
+    mode_resend_s: float = 0.5
+    disarm_resend_s: float = 0.2  # kill: ≥ 5 Hz
+    arm_resend_s: float = 1.0
+    arm_timeout_s: float = 30.0
+    # After arming, motors held at minimum: ArduCopter 4.x keeps them there ~2 s, then spools up
+    # over MOT_SPOOL_TIME (0.5 s); 3.2.1 spins at once.
+    spool_s: float = 0.5
+    force_disarm: bool = False  # 4.x takes 21196 to disarm in the air; 3.2.1 has no force
+    # 3.2.1 refuses to disarm outside a manual mode until landed: a kill switches to STABILIZE
+    stabilize_to_disarm: bool = True
+    ramp_below_hover_us: int = 150  # the take-off ramp starts this far below the hover stick
+    ramp_rate_us_per_s: float = 100.0
+    ramp_above_hover_us: int = 250  # and gives up this far above it
+    takeoff_give_up_s: float = 3.0  # at the top of the ramp without leaving the floor
+    liftoff_rise_m: float = 0.04  # above the rest height ...
+    liftoff_vel_mps: float = 0.08  # ... and climbing: airborne
+    liftoff_lag_s: float = 0.3  # the ramp's last stretch, spent before lift-off was seen
+    pickup_band_us: int = 25  # the pilot's throttle takes over within this of the held one
+    quit_timeout_s: float = 10.0  # a quitting station waits this long for LAND to show
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.degraded_after_s < self.lost_after_s:
+            raise ValueError("need 0 < degraded_after_s < lost_after_s")
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, float) and v < 0.0:
+                raise ValueError(f"{f.name} must be >= 0, got {v}")
+
+    @classmethod
+    def for_dialect(cls, dialect: Dialect, **overrides: object) -> SupervisorParams:
+        """The policy for one firmware (unknown: the stricter 4.x timings without force)."""
+        if dialect is Dialect.APM25:
+            base = cls()
+        elif dialect is Dialect.COPTER4:
+            base = cls(spool_s=3.0, force_disarm=True, stabilize_to_disarm=False)
+        else:
+            base = cls(spool_s=3.0)
+        return dataclasses.replace(base, **overrides)  # type: ignore[arg-type]

@@ -1,0 +1,459 @@
+"""The one place that decides, every tick, which stick command and which messages are safe.
+
+A pure state machine in the manner of PX4's failsafe framework: `step(TickIn)` takes the pilot's
+intents, the vehicle's heartbeat state, how long the vehicle has been silent, the altitude
+estimate and the attitude, and returns the override to send (or none), whether to send GCS
+heartbeats, the command messages to send, and the reasons for every change of state. No clock,
+no I/O: the station does the sending, `replay --rerun` feeds the recorded inputs back.
+
+The rules, most severe first (see `params` for the link-loss policy):
+- KILL wins in every state: throttle minimum from this tick, disarm (forced on 4.x) every
+  `disarm_resend_s` until a heartbeat newer than the kill says disarmed — whatever the link says.
+- A long silence lands a vehicle that may be flying; nothing undoes that when the link returns.
+- A mode the station did not ask for, or a disarm, ends PC control; back in STABILIZE the
+  throttle stays at minimum until the pilot's stick comes down to meet it.
+- Take-off waits for the motors: throttle minimum through the spool-up, then an open-loop ramp
+  that stops the moment the vehicle is seen to leave the floor; only then does the PID run.
+"""
+
+from __future__ import annotations
+
+import math
+
+from firmware_link.records import FlightMode, RcCommand
+from gcs.altitude_controller import AltControlOutput, AltitudeController
+from gcs.position_controller import PositionCommand, PositionController, PositionSetpoint
+from gcs.supervisor.params import SupervisorParams
+from gcs.supervisor.types import (
+    AIRBORNE_CAPABLE,
+    PC_CONTROL,
+    STICK_MAX_US,
+    STICK_MID_US,
+    STICK_MIN_US,
+    Action,
+    ActionKind,
+    Intent,
+    IntentKind,
+    Level,
+    LinkHealth,
+    Note,
+    SupervisorOutput,
+    SupervisorState,
+    TickIn,
+    Transition,
+)
+
+S = SupervisorState
+MOCAP_STALE_S = 0.25
+LANDING_MODES = frozenset({FlightMode.LAND, FlightMode.RTL, FlightMode.AUTO, FlightMode.GUIDED})
+"""Modes that ignore the throttle stick (or use it only to disarm): send it at minimum."""
+MANUAL_THROTTLE_MODES = frozenset({FlightMode.STABILIZE, FlightMode.ACRO})
+LEVEL = RcCommand(STICK_MID_US, STICK_MID_US, STICK_MIN_US, STICK_MID_US)
+
+
+def _mode_name(mode: int) -> str:
+    try:
+        return FlightMode(mode).name
+    except ValueError:
+        return f"mode {mode}"
+
+
+class Supervisor:
+    """State machine around the altitude and position controllers (which it owns)."""
+
+    def __init__(self, params: SupervisorParams, alt_ctrl: AltitudeController,
+                 pos_ctrl: PositionController, *, rest_alt_m: float, ground_alt_m: float) -> None:
+        self.p = params
+        self.alt_ctrl = alt_ctrl
+        self.pos_ctrl = pos_ctrl
+        self.rest_alt_m = rest_alt_m
+        self.ground_alt_m = ground_alt_m
+        self.state = S.DISARMED
+        self.since_s = 0.0
+        self.sticks = RcCommand()
+        self.command = LEVEL
+        self.requested_mode: int | None = None
+        self.preflight_ok = False
+        self.preflight_note = "pre-flight checks not run"
+        self.alt_target_m: float | None = None
+        self.alt_rate_mps: float | None = None
+        self.alt_setpoint_m: float | None = None
+        self.pos_setpoint: PositionSetpoint | None = None
+        self.alt: AltControlOutput | None = None
+        self.position: PositionCommand | None = None
+        self.gate_us: int | None = None
+        self._gate_side = 0
+        self._takeoff_wanted = False
+        self._armed_at_s = -math.inf
+        self._kill_at_s = -math.inf
+        self._lost_at_s = -math.inf
+        self._next_send_s = -math.inf
+        self._ramp_us = 0.0
+        self._ramp_top_since_s: float | None = None
+        self._frozen: RcCommand | None = None
+        self._mocap_ok = False
+        self._link = LinkHealth.OK
+        self._actions: list[Action] = []
+        self._notes: list[Note] = []
+        self._transitions: list[Transition] = []
+        self._t = 0.0
+
+    # ------------------------------------------------------------------ bookkeeping
+    def _go(self, state: SupervisorState, reason: str, level: Level = Level.INFO) -> None:
+        if state is self.state:
+            return
+        self._transitions.append(Transition(self._t, self.state, state, reason))
+        self._notes.append(Note(level, f"{state.value}: {reason}"))
+        self.state = state
+        self.since_s = self._t
+        self._next_send_s = -math.inf  # a new state's first message goes out at once
+        if state is S.TAKEOFF:
+            self._ramp_us = -1.0  # set from the hover stick on the first take-off tick
+            self._ramp_top_since_s = None
+
+    def _note(self, level: Level, text: str) -> None:
+        self._notes.append(Note(level, text))
+
+    def _send_every(self, period_s: float, *actions: Action) -> None:
+        if self._t >= self._next_send_s:
+            self._actions.extend(actions)
+            self._next_send_s = self._t + period_s
+
+    def _to_manual(self, reason: str, gate_us: int | None, level: Level = Level.INFO) -> None:
+        """Hand the sticks to the pilot; the throttle waits at `gate_us` until the stick meets
+        it."""
+        self.gate_us = gate_us
+        if gate_us is not None:
+            thr = self.sticks.throttle_us
+            self._gate_side = (thr > gate_us) - (thr < gate_us)
+        self.alt = None
+        self.position = None
+        self._takeoff_wanted = False
+        self._go(S.MANUAL, reason, level)
+
+    def _end_pc_control(self) -> None:
+        self.alt = None
+        self.position = None
+        self.alt_setpoint_m = None
+        self._takeoff_wanted = False
+
+    def on_floor(self, alt_m: float) -> bool:
+        """Whether an altitude estimate means standing on the floor."""
+        return alt_m < self.ground_alt_m
+
+    # ------------------------------------------------------------------ the tick
+    def step(self, inp: TickIn) -> SupervisorOutput:
+        """Decide this tick's command and messages."""
+        self._t = inp.t_s
+        self._actions, self._notes, self._transitions = [], [], []
+        for intent in inp.intents:
+            self._apply(intent, inp)
+        self._link = self._health(inp)
+        self._watch_link(inp)
+        if self._link is not LinkHealth.LOST:
+            self._watch_vehicle(inp)
+        command, heartbeat = self._run(inp)
+        if command is not None:
+            self.command = command
+        return SupervisorOutput(
+            state=self.state, link=self._link, command=command, heartbeat=heartbeat,
+            actions=tuple(self._actions), notes=tuple(self._notes),
+            transitions=tuple(self._transitions),
+            alt_setpoint_m=self.alt_setpoint_m if self.state in PC_CONTROL else None,
+            throttle_gate_us=self.gate_us if self.state is S.MANUAL else None)
+
+    def _health(self, inp: TickIn) -> LinkHealth:
+        age = inp.vehicle.frame_age_s
+        if age > self.p.lost_after_s:
+            return LinkHealth.LOST
+        if age > self.p.degraded_after_s:
+            return LinkHealth.DEGRADED
+        return LinkHealth.OK
+
+    # ------------------------------------------------------------------ intents
+    def _apply(self, it: Intent, inp: TickIn) -> None:
+        k = it.kind
+        if k is IntentKind.STICKS:
+            self.sticks = RcCommand(it.roll_us, it.pitch_us, it.throttle_us, it.yaw_us)
+        elif k is IntentKind.KILL:
+            self._kill_at_s = self._t
+            self._end_pc_control()
+            self._go(S.KILLED, "pilot kill: throttle minimum, disarm until seen", Level.WARNING)
+        elif k is IntentKind.PREFLIGHT:
+            self.preflight_ok, self.preflight_note = it.ok, it.note
+            self._note(Level.INFO if it.ok else Level.WARNING,
+                       f"pre-flight {'passed' if it.ok else 'FAILED'}: {it.note}")
+        elif self.state in (S.KILLED, S.RELEASED):
+            self._note(Level.WARNING, f"{k.value} ignored: station is {self.state.value}")
+        elif k is IntentKind.QUIT:
+            self._quit(inp)
+        elif self.state in (S.LINK_LOST, S.SILENT, S.QUITTING):
+            self._note(Level.WARNING, f"{k.value} ignored while {self.state.value}")
+        elif k is IntentKind.ARM:
+            self._arm()
+        elif k is IntentKind.DISARM:
+            self._actions.append(Action(ActionKind.DISARM))
+            self._note(Level.INFO, "disarm requested")
+        elif k is IntentKind.SET_MODE:
+            self.requested_mode = it.mode
+            self._actions.append(Action(ActionKind.SET_MODE, it.mode))
+            self._note(Level.INFO, f"mode {_mode_name(it.mode)} requested")
+        elif k is IntentKind.ALT_HOLD:
+            self._alt_hold(it, inp)
+        elif k is IntentKind.ALT_HOLD_OFF:
+            if self.state in PC_CONTROL:
+                self._end_pc_control()
+                self._to_manual("altitude hold off: the pilot's throttle takes over where the "
+                                "hold left it", self.command.throttle_us)
+        elif k is IntentKind.POSITION:
+            if self.pos_setpoint is None:
+                self.pos_ctrl.reset()  # a new hold starts clean; a moved one keeps its state
+            self.pos_setpoint = PositionSetpoint(it.north_m, it.east_m, it.yaw_rad)
+        elif k is IntentKind.POSITION_OFF:
+            self.pos_setpoint = None
+
+    def _arm(self) -> None:
+        if self.state is not S.DISARMED:
+            self._note(Level.WARNING, f"arm ignored: already {self.state.value}")
+        elif not self.preflight_ok:
+            self._note(Level.ERROR, f"arm refused: {self.preflight_note}")
+        else:
+            self._go(S.ARMING, "arm requested")
+
+    def _alt_hold(self, it: Intent, inp: TickIn) -> None:
+        if self.state in (S.DISARMED, S.ARMING, S.VEHICLE):
+            why = ("arm first" if self.state is not S.VEHICLE else
+                   f"the vehicle flies itself in {_mode_name(inp.vehicle.mode)}; "
+                   "switch to STABILIZE first")
+            if self.state is S.ARMING:
+                self._takeoff_wanted = True
+                self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
+                return
+            self._note(Level.WARNING, f"altitude hold refused: {why}")
+            return
+        if inp.vehicle.mode != FlightMode.STABILIZE:
+            self._note(Level.WARNING, "altitude hold refused: the PC flies in STABILIZE, the "
+                       f"vehicle is in {_mode_name(inp.vehicle.mode)}")
+            return
+        self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
+        if self.state is S.MANUAL:
+            if self.on_floor(inp.estimate.alt_m):
+                self._go(S.SPOOL_UP if self._t - self._armed_at_s < self.p.spool_s
+                         else S.TAKEOFF, "take-off asked")
+            else:
+                self._engage(inp, self.command.throttle_us, "altitude hold on")
+
+    def _quit(self, inp: TickIn) -> None:
+        v = inp.vehicle
+        if self.state in (S.DISARMED, S.ARMING) or (v.seen and not v.armed):
+            self._release("quit: vehicle disarmed")
+        elif self.state in (S.SILENT, S.LINK_LOST):
+            self._note(Level.WARNING, f"quit while {self.state.value}: the vehicle's own "
+                       "failsafe lands it")
+        else:
+            self._go(S.QUITTING, "quit while armed: LAND first, then release", Level.WARNING)
+
+    def _release(self, reason: str) -> None:
+        self._end_pc_control()
+        self._actions.append(Action(ActionKind.RELEASE))
+        self._go(S.RELEASED, reason)
+
+    # ------------------------------------------------------------------ observations
+    def _watch_link(self, inp: TickIn) -> None:
+        if self._link is not LinkHealth.LOST or self.state not in AIRBORNE_CAPABLE:
+            return
+        self._lost_at_s = self._t
+        self._end_pc_control()
+        self._go(S.LINK_LOST, f"nothing heard from the vehicle for "
+                 f"{inp.vehicle.frame_age_s:.1f} s: commanding LAND", Level.ERROR)
+
+    def _watch_vehicle(self, inp: TickIn) -> None:
+        v = inp.vehicle
+        if not v.seen:
+            return
+        st = self.state
+        if st is S.KILLED:
+            if not v.armed and v.heartbeat_t_s >= self._kill_at_s:
+                self._go(S.DISARMED, "disarmed after kill")
+            return
+        if st is S.SILENT:
+            self._go(S.LINK_LOST, "the vehicle is heard again: heartbeats back on, the landing "
+                     "stands", Level.WARNING)
+            st = self.state
+        if not v.armed:
+            if st is S.QUITTING:
+                self._release("vehicle disarmed")
+            elif st in AIRBORNE_CAPABLE - {S.ARMING} or st is S.LINK_LOST:
+                self._end_pc_control()
+                self._go(S.DISARMED, "vehicle disarmed", Level.WARNING)
+            return
+        if st is S.DISARMED:
+            self._armed_at_s = self._t
+            self._to_manual("vehicle armed (not by this station)", STICK_MIN_US, Level.WARNING)
+        elif st is S.ARMING:
+            self._armed_at_s = self._t
+            if self._takeoff_wanted:
+                self._go(S.SPOOL_UP, "armed: waiting for the motors to spool up")
+            else:
+                self._to_manual("armed", STICK_MIN_US)
+        elif st is S.QUITTING:
+            if v.mode == FlightMode.LAND:
+                self._release("vehicle in LAND: overrides released")
+        elif st is S.LINK_LOST:
+            if v.mode == FlightMode.LAND:
+                self._go(S.VEHICLE, "the vehicle is heard again and lands in LAND")
+        else:
+            self._watch_mode(v.mode)
+
+    def _watch_mode(self, mode: int) -> None:
+        asked = self.requested_mode == mode
+        how = "as asked" if asked else "by itself"
+        st = self.state
+        if st in PC_CONTROL:
+            if mode != FlightMode.STABILIZE:
+                self._end_pc_control()
+                self._go(S.VEHICLE, f"vehicle in {_mode_name(mode)} {how}: PC control off",
+                         Level.INFO if asked else Level.WARNING)
+        elif st is S.MANUAL:
+            if mode in LANDING_MODES or (not asked and mode not in MANUAL_THROTTLE_MODES
+                                         and self.requested_mode is not None):
+                self._go(S.VEHICLE, f"vehicle in {_mode_name(mode)} {how}",
+                         Level.INFO if asked else Level.WARNING)
+        elif st is S.VEHICLE:
+            if mode in MANUAL_THROTTLE_MODES:
+                self._to_manual(f"vehicle in {_mode_name(mode)} {how}: throttle held at minimum "
+                                "until the pilot's stick comes down to it", STICK_MIN_US)
+            elif asked and mode not in LANDING_MODES:
+                self._to_manual(f"vehicle in {_mode_name(mode)} as asked", None)
+
+    # ------------------------------------------------------------------ commands per state
+    def _run(self, inp: TickIn) -> tuple[RcCommand | None, bool]:
+        st = self.state
+        if st is S.KILLED:
+            disarm = Action(ActionKind.FORCE_DISARM if self.p.force_disarm else ActionKind.DISARM)
+            acts = [disarm]
+            if (self.p.stabilize_to_disarm and inp.vehicle.mode not in MANUAL_THROTTLE_MODES):
+                acts.insert(0, Action(ActionKind.SET_MODE, FlightMode.STABILIZE))
+            self._send_every(self.p.disarm_resend_s, *acts)
+            return LEVEL, True
+        if st in (S.DISARMED, S.RELEASED):
+            return (None if st is S.RELEASED else LEVEL), True
+        if st is S.ARMING:
+            if self._t - self.since_s > self.p.arm_timeout_s:
+                self._go(S.DISARMED, f"vehicle did not arm within {self.p.arm_timeout_s:g} s",
+                         Level.ERROR)
+            else:
+                self._send_every(self.p.arm_resend_s, Action(ActionKind.ARM))
+            return LEVEL, True
+        if st is S.LINK_LOST:
+            if self._t - self._lost_at_s >= self.p.land_request_s and self._link is LinkHealth.LOST:
+                self._go(S.SILENT, "still nothing heard: overrides and heartbeats stopped so the "
+                         "vehicle's own failsafe lands it", Level.ERROR)
+                return None, False
+            self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
+            return self._safe_hold(), True
+        if st is S.SILENT:
+            return None, False
+        if st is S.VEHICLE:
+            thr = STICK_MIN_US if inp.vehicle.mode in LANDING_MODES else STICK_MID_US
+            return RcCommand(STICK_MID_US, STICK_MID_US, thr, STICK_MID_US), True
+        if st is S.QUITTING:
+            if self._t - self.since_s > self.p.quit_timeout_s:
+                self._note(Level.ERROR, "quit: LAND not confirmed in time")
+            self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
+            return (self._hold(inp) if self.alt is not None else self._manual()), True
+        if st is S.MANUAL:
+            return self._manual(), True
+        if st is S.SPOOL_UP:
+            if self._t - self._armed_at_s >= self.p.spool_s:
+                self._go(S.TAKEOFF, "motors spooled: throttle ramp until the vehicle lifts")
+            return LEVEL, True
+        if st is S.TAKEOFF:
+            return self._takeoff(inp), True
+        return self._hold(inp), True
+
+    def _safe_hold(self) -> RcCommand:
+        """A silent vehicle gets hover throttle, level, no yaw: no climb, no chase."""
+        return RcCommand(STICK_MID_US, STICK_MID_US, self.alt_ctrl.hover_stick_us(), STICK_MID_US)
+
+    def _manual(self) -> RcCommand:
+        s = self.sticks
+        if self.gate_us is not None:
+            side = (s.throttle_us > self.gate_us) - (s.throttle_us < self.gate_us)
+            near = abs(s.throttle_us - self.gate_us) <= self.p.pickup_band_us
+            if near or side != self._gate_side:
+                self.gate_us = None
+                self._note(Level.INFO, "the pilot's throttle has the vehicle")
+            else:
+                return RcCommand(s.roll_us, s.pitch_us, self.gate_us, s.yaw_us)
+        return s
+
+    # ------------------------------------------------------------------ PC control
+    def _takeoff(self, inp: TickIn) -> RcCommand:
+        p = self.p
+        est = inp.estimate
+        hover = self.alt_ctrl.hover_stick_us()
+        if self._ramp_us < 0.0:
+            self._ramp_us = float(max(STICK_MIN_US, hover - p.ramp_below_hover_us))
+        if self._link is LinkHealth.DEGRADED:  # stale estimate: neither climb nor decide
+            return RcCommand(STICK_MID_US, STICK_MID_US, round(self._ramp_us), STICK_MID_US)
+        airborne = (est.alt_m > self.rest_alt_m + p.liftoff_rise_m
+                    and est.vel_mps > p.liftoff_vel_mps)
+        if airborne:
+            back = p.ramp_rate_us_per_s * p.liftoff_lag_s
+            self._engage(inp, max(STICK_MIN_US, self._ramp_us - back),
+                         f"left the floor at {round(self._ramp_us)} us: altitude hold on")
+            return self._hold(inp)
+        top = min(STICK_MAX_US, hover + p.ramp_above_hover_us)
+        self._ramp_us = min(top, self._ramp_us + p.ramp_rate_us_per_s * inp.dt_s)
+        if self._ramp_us >= top:
+            self._ramp_top_since_s = self._ramp_top_since_s or self._t
+            if self._t - self._ramp_top_since_s > p.takeoff_give_up_s:
+                self._to_manual(f"take-off: the vehicle did not leave the floor at "
+                                f"{top} us", STICK_MIN_US, Level.ERROR)
+                return LEVEL
+        return RcCommand(STICK_MID_US, STICK_MID_US, round(self._ramp_us), STICK_MID_US)
+
+    def _engage(self, inp: TickIn, throttle_us: float, reason: str) -> None:
+        self.alt_ctrl.engage(inp.estimate, throttle_us, inp.roll_rad, inp.pitch_rad)
+        self.alt_setpoint_m = inp.estimate.alt_m
+        self._frozen = None
+        self._go(S.HOLD, reason)
+
+    def _hold(self, inp: TickIn) -> RcCommand:
+        if self._link is LinkHealth.DEGRADED:
+            if self._frozen is None:
+                self._frozen = self._safe_hold()
+                self._note(Level.WARNING, "telemetry gap: holding hover throttle, level")
+            return self._frozen
+        if self._frozen is not None:
+            self._frozen = None
+            self._note(Level.INFO, "telemetry back: altitude hold resumes")
+        est = inp.estimate
+        assert self.alt_setpoint_m is not None
+        target = self.alt_target_m if self.alt_target_m is not None else self.alt_setpoint_m
+        if self.alt_rate_mps is None:
+            self.alt_setpoint_m = target
+        else:
+            step = self.alt_rate_mps * inp.dt_s
+            self.alt_setpoint_m += min(max(target - self.alt_setpoint_m, -step), step)
+        floor = self.on_floor(est.alt_m) and self.alt_setpoint_m <= est.alt_m
+        self.alt = self.alt_ctrl.update(self.alt_setpoint_m, est, inp.roll_rad, inp.pitch_rad,
+                                        inp.dt_s, on_floor=floor)
+        s = self.sticks
+        roll, pitch, yaw = s.roll_us, s.pitch_us, s.yaw_us
+        self.position = None
+        if self.pos_setpoint is not None:
+            pose = inp.mocap
+            fresh = pose is not None and inp.t_s - pose.t_s <= MOCAP_STALE_S
+            if fresh and pose is not None:
+                self.position = self.pos_ctrl.update(self.pos_setpoint, pose, inp.dt_s)
+                roll, pitch, yaw = (self.position.roll_us, self.position.pitch_us,
+                                    self.position.yaw_us)
+            else:
+                roll, pitch, yaw = STICK_MID_US, STICK_MID_US, STICK_MID_US
+            if fresh != self._mocap_ok:
+                self._note(Level.INFO if fresh else Level.WARNING,
+                           "motion capture " + ("tracking" if fresh else "lost: holding level"))
+                self._mocap_ok = fresh
+        return RcCommand(roll, pitch, self.alt.throttle_us, yaw)

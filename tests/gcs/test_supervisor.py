@@ -1,0 +1,355 @@
+"""The supervisor as a pure state machine: scripted inputs, no sockets, no clocks."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from firmware_link.records import Dialect, FlightMode, MocapPose
+from gcs.altitude_controller import AltitudeController, AltitudeControllerParams
+from gcs.estimation import AltEstimate, SonarStatus
+from gcs.position_controller import PositionController, PositionControllerParams
+from gcs.supervisor import (
+    ActionKind,
+    Intent,
+    IntentKind,
+    LinkHealth,
+    Supervisor,
+    SupervisorOutput,
+    SupervisorParams,
+    TickIn,
+    VehicleStatus,
+)
+from gcs.supervisor import SupervisorState as S
+from gcs.thrust_curve import ThrottleCurve
+
+DT = 0.025
+REST_M = 0.06
+
+
+class Script:
+    """Drives a supervisor tick by tick with a scripted vehicle."""
+
+    def __init__(self, dialect: Dialect = Dialect.APM25, **params: object) -> None:
+        self.sup = Supervisor(SupervisorParams.for_dialect(dialect, **params),
+                              AltitudeController(AltitudeControllerParams(),
+                                                 ThrottleCurve.for_dialect(dialect)),
+                              PositionController(PositionControllerParams()),
+                              rest_alt_m=REST_M, ground_alt_m=0.10)
+        self.t = 100.0
+        self.armed = False
+        self.mode = int(FlightMode.STABILIZE)
+        self.hb_t = self.t
+        self.rx_t = self.t
+        self.down = True  # the vehicle is heard
+        self.alt = REST_M
+        self.vel = 0.0
+        self.mocap: MocapPose | None = None
+        self.outs: list[SupervisorOutput] = []
+
+    def tick(self, *intents: Intent) -> SupervisorOutput:
+        self.t += DT
+        if self.down:
+            self.rx_t = self.t
+            if self.t - self.hb_t >= 1.0:
+                self.hb_t = self.t
+        est = AltEstimate(self.t, self.alt, self.vel, 0.0, 0.0, True, SonarStatus.USED, 0.0, 0.0,
+                          False, 0.01, 0)
+        v = VehicleStatus(seen=True, armed=self.armed, mode=self.mode, heartbeat_t_s=self.hb_t,
+                          frame_age_s=self.t - self.rx_t)
+        out = self.sup.step(TickIn(self.t, DT, intents, v, est, 0.0, 0.0, self.mocap))
+        self.outs.append(out)
+        return out
+
+    def run(self, seconds: float) -> list[SupervisorOutput]:
+        n = round(seconds / DT)
+        return [self.tick() for _ in range(n)]
+
+    def heartbeat_now(self) -> None:
+        self.hb_t = self.t + DT  # the next tick carries a fresh heartbeat
+
+    def armed_in_stabilize(self) -> None:
+        self.tick(Intent(IntentKind.PREFLIGHT, ok=True, note="test"))
+        out = self.tick(Intent(IntentKind.ARM))
+        assert any(a.kind is ActionKind.ARM for a in out.actions)
+        self.armed = True
+        self.heartbeat_now()
+        self.tick()
+        assert self.sup.state is S.MANUAL
+
+    def hovering(self, alt_m: float = 1.0) -> None:
+        """Armed, in HOLD at alt_m (the vehicle follows perfectly)."""
+        self.armed_in_stabilize()
+        self.alt = alt_m
+        self.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=alt_m))
+        assert self.sup.state is S.HOLD
+
+
+def actions(outs: list[SupervisorOutput], kind: ActionKind) -> list[float]:
+    return [o.actions and next(a.mode for a in o.actions if a.kind is kind)
+            for o in outs if any(a.kind is kind for a in o.actions)]
+
+
+def test_arm_refused_until_preflight_passes() -> None:
+    s = Script()
+    out = s.tick(Intent(IntentKind.ARM))
+    assert s.sup.state is S.DISARMED and not out.actions
+    assert any("arm refused" in n.text for n in out.notes)
+    s.tick(Intent(IntentKind.PREFLIGHT, ok=False, note="FS_GCS_ENABLE is 0"))
+    out = s.tick(Intent(IntentKind.ARM))
+    assert any("FS_GCS_ENABLE is 0" in n.text for n in out.notes)
+    s.tick(Intent(IntentKind.PREFLIGHT, ok=True, note="ok"))
+    s.tick(Intent(IntentKind.ARM))
+    assert s.sup.state is S.ARMING
+
+
+def test_arming_is_resent_every_second_and_times_out() -> None:
+    s = Script(arm_timeout_s=5.0)
+    s.tick(Intent(IntentKind.PREFLIGHT, ok=True))
+    s.tick(Intent(IntentKind.ARM))
+    outs = s.run(4.0)
+    assert len(actions(outs, ActionKind.ARM)) == 4
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+    s.run(1.5)
+    assert s.sup.state is S.DISARMED
+
+
+def test_kill_from_hold_throttle_min_next_tick_and_disarm_at_5_hz_until_seen() -> None:
+    s = Script(Dialect.COPTER4)
+    s.hovering()
+    out = s.tick(Intent(IntentKind.KILL))
+    assert out.state is S.KILLED and out.command is not None and out.command.throttle_us == 1000
+    outs = [out, *s.run(1.0)]
+    assert len(actions(outs, ActionKind.FORCE_DISARM)) >= 5
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+    s.armed = False
+    s.heartbeat_now()
+    s.tick()
+    assert s.sup.state is S.DISARMED
+
+
+@pytest.mark.parametrize("fault", ["down", "up_and_down"])
+def test_kill_while_the_link_is_lost_still_cuts_and_repeats(fault: str) -> None:
+    s = Script()
+    s.hovering()
+    s.down = False
+    s.run(2.0)
+    assert s.sup.state is S.LINK_LOST
+    out = s.tick(Intent(IntentKind.KILL))
+    assert out.command is not None and out.command.throttle_us == 1000 and out.heartbeat
+    outs = s.run(5.0)  # silence never returns once killed
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+    assert len(actions(outs, ActionKind.DISARM)) >= 25  # 3.2.1: no force
+    s.down = True
+    s.armed = False
+    s.heartbeat_now()
+    s.tick()
+    assert s.sup.state is S.DISARMED
+
+
+def test_kill_on_apm25_in_land_switches_to_stabilize_so_disarm_is_accepted() -> None:
+    s = Script(Dialect.APM25)
+    s.hovering()
+    s.mode = int(FlightMode.LAND)
+    s.heartbeat_now()
+    s.tick()
+    out = s.tick(Intent(IntentKind.KILL))
+    kinds = [a.kind for a in out.actions]
+    assert kinds == [ActionKind.SET_MODE, ActionKind.DISARM]
+    assert out.actions[0].mode == FlightMode.STABILIZE
+
+
+def test_short_gap_holds_hover_throttle_level_then_hold_resumes() -> None:
+    s = Script()
+    s.hovering()
+    s.run(1.0)
+    hover = s.sup.alt_ctrl.hover_stick_us()
+    s.down = False
+    outs = s.run(0.6)
+    held = [o for o in outs if o.link is LinkHealth.DEGRADED]
+    assert held and all(o.command == held[0].command for o in held)
+    cmd = held[0].command
+    assert cmd is not None and abs(cmd.throttle_us - hover) <= 3 and cmd.roll_us == 1500
+    assert s.sup.state is S.HOLD
+    s.down = True
+    out = s.tick()
+    assert out.link is LinkHealth.OK and s.sup.state is S.HOLD and s.sup.alt is not None
+
+
+def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
+    s = Script()
+    s.hovering()
+    s.run(1.0)
+    s.down = False
+    outs = s.run(1.2)
+    assert s.sup.state is S.LINK_LOST
+    outs += s.run(2.9)
+    lands = actions(outs, ActionKind.SET_MODE)
+    assert lands and all(m == FlightMode.LAND for m in lands)
+    assert len(lands) >= 5  # every 0.5 s while the uplink may work
+    outs = s.run(0.5)
+    assert s.sup.state is S.SILENT
+    assert all(o.command is None and not o.heartbeat for o in outs[-5:])
+    # the link comes back with the vehicle still in STABILIZE: keep asking for LAND
+    s.down = True
+    s.heartbeat_now()
+    outs = s.run(1.0)
+    assert s.sup.state is S.LINK_LOST and all(o.heartbeat for o in outs)
+    assert actions(outs, ActionKind.SET_MODE)
+    assert s.sup.alt is None  # PC hold did not resume by itself
+    s.mode = int(FlightMode.LAND)
+    s.heartbeat_now()
+    s.tick()
+    assert s.sup.state is S.VEHICLE
+    out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=1.0))
+    assert s.sup.state is S.VEHICLE and any("refused" in n.text for n in out.notes)
+
+
+def test_land_mode_by_itself_ends_pc_control_and_stabilize_keeps_throttle_at_minimum() -> None:
+    s = Script()
+    s.hovering()
+    s.run(1.0)
+    s.mode = int(FlightMode.LAND)
+    s.heartbeat_now()
+    out = s.tick()
+    assert out.state is S.VEHICLE and any("by itself" in n.text for n in out.notes)
+    outs = s.run(2.0)
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+    assert s.sup.alt is None
+    # the pilot switches back to STABILIZE with the stick still up: throttle stays at minimum
+    s.tick(Intent(IntentKind.STICKS, throttle_us=1600),
+           Intent(IntentKind.SET_MODE, mode=int(FlightMode.STABILIZE)))
+    s.mode = int(FlightMode.STABILIZE)
+    s.heartbeat_now()
+    s.tick()
+    assert s.sup.state is S.MANUAL
+    outs = s.run(1.0)
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+    s.tick(Intent(IntentKind.STICKS, throttle_us=1000))
+    s.tick(Intent(IntentKind.STICKS, throttle_us=1300))
+    assert s.outs[-1].command is not None and s.outs[-1].command.throttle_us == 1300
+
+
+def test_land_asked_by_the_pilot_keeps_hold_until_the_heartbeat_shows_it() -> None:
+    s = Script()
+    s.hovering()
+    out = s.tick(Intent(IntentKind.SET_MODE, mode=int(FlightMode.LAND)))
+    assert s.sup.state is S.HOLD and out.command is not None and out.command.throttle_us > 1000
+    s.mode = int(FlightMode.LAND)
+    s.heartbeat_now()
+    out = s.tick()
+    assert out.state is S.VEHICLE and any("as asked" in n.text for n in out.notes)
+
+
+def test_disarm_by_itself_before_takeoff_ends_everything_without_windup() -> None:
+    s = Script()
+    s.armed_in_stabilize()
+    s.run(2.0)
+    s.armed = False  # 3.2.1's auto-disarm at minimum throttle
+    s.heartbeat_now()
+    out = s.tick()
+    assert out.state is S.DISARMED
+    out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=1.0))
+    assert s.sup.state is S.DISARMED and s.sup.alt is None
+    assert out.command is not None and out.command.throttle_us == 1000
+
+
+def test_takeoff_waits_for_spool_up_then_ramps_until_liftoff_with_no_integrator_growth() -> None:
+    s = Script(Dialect.COPTER4)
+    s.armed_in_stabilize()
+    s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=1.0, rate_mps=0.5))
+    assert s.sup.state is S.SPOOL_UP
+    outs = s.run(2.9)
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+    outs = s.run(0.2)
+    assert s.sup.state is S.TAKEOFF
+    outs = s.run(1.0)
+    thr = [o.command.throttle_us for o in outs if o.command is not None]
+    assert thr == sorted(thr) and thr[-1] > thr[0]  # the ramp only rises
+    assert s.sup.alt is None  # no PID (no integrator) on the floor
+    s.alt, s.vel = REST_M + 0.06, 0.2  # the vehicle leaves the floor
+    s.tick()
+    assert s.sup.state is S.HOLD and s.sup.alt_setpoint_m == pytest.approx(REST_M + 0.06, abs=0.02)
+
+
+def test_takeoff_gives_up_when_the_vehicle_never_lifts() -> None:
+    s = Script(Dialect.APM25)
+    s.armed_in_stabilize()
+    s.run(1.0)
+    s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=1.0))
+    assert s.sup.state is S.TAKEOFF
+    s.run(10.0)
+    assert s.sup.state is S.MANUAL
+    assert s.outs[-1].command is not None and s.outs[-1].command.throttle_us == 1000
+
+
+def test_integrator_frozen_on_the_floor_and_against_the_stick_clamp() -> None:
+    s = Script()
+    s.hovering(alt_m=1.0)
+    s.alt = REST_M  # estimate on the floor, setpoint above: no thrust moves it, do not wind up
+    s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=REST_M - 0.02))
+    i0 = s.sup.alt_ctrl.pid.integrator
+    s.run(2.0)
+    assert s.sup.alt_ctrl.pid.integrator == pytest.approx(i0)
+    s.alt = 0.5  # far below a 3 m setpoint: the stick pins at 2000 and I must stop growing
+    s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=3.0))
+    s.run(0.5)
+    pinned = [o for o in s.run(2.0) if o.command is not None and o.command.throttle_us == 2000]
+    i1 = s.sup.alt_ctrl.pid.integrator
+    s.run(2.0)
+    if pinned:
+        assert s.sup.alt_ctrl.pid.integrator <= i1 + 1e-9
+    assert s.sup.alt is not None and (s.sup.alt.saturated or not pinned)
+
+
+def test_quit_while_hovering_lands_first_and_releases_after_land_is_seen() -> None:
+    s = Script()
+    s.hovering()
+    out = s.tick(Intent(IntentKind.QUIT))
+    assert s.sup.state is S.QUITTING
+    assert any(a.kind is ActionKind.SET_MODE and a.mode == FlightMode.LAND for a in out.actions)
+    assert out.command is not None and out.command.throttle_us > 1000  # still holding
+    s.mode = int(FlightMode.LAND)
+    s.heartbeat_now()
+    out = s.tick()
+    assert s.sup.state is S.RELEASED and any(a.kind is ActionKind.RELEASE for a in out.actions)
+    assert s.tick().command is None
+
+
+def test_quit_disarmed_releases_at_once() -> None:
+    s = Script()
+    out = s.tick(Intent(IntentKind.QUIT))
+    assert s.sup.state is S.RELEASED and any(a.kind is ActionKind.RELEASE for a in out.actions)
+
+
+def test_vehicle_armed_by_someone_else_gets_the_throttle_gate() -> None:
+    s = Script()
+    s.tick(Intent(IntentKind.STICKS, throttle_us=1500))
+    s.armed = True
+    s.heartbeat_now()
+    s.tick()
+    assert s.sup.state is S.MANUAL
+    assert s.tick().command is not None and s.outs[-1].command.throttle_us == 1000
+
+
+def test_position_hold_levels_when_motion_capture_goes_stale() -> None:
+    s = Script()
+    s.hovering()
+    q = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))  # facing east
+    s.mocap = MocapPose(s.t, 1, (0.0, 0.0, -1.0), q, 0)
+    s.tick(Intent(IntentKind.POSITION, north_m=1.0, east_m=0.0, yaw_rad=math.pi / 2))
+    s.mocap = MocapPose(s.t + DT, 1, (0.0, 0.0, -1.0), q, 0)
+    out = s.tick()
+    assert out.command is not None and out.command.roll_us < 1500  # target north: roll left
+    s.run(0.5)  # the pose is now older than 0.25 s
+    assert s.outs[-1].command is not None and s.outs[-1].command.roll_us == 1500
+
+
+def test_intents_are_ignored_while_the_link_is_lost_except_kill() -> None:
+    s = Script()
+    s.hovering()
+    s.down = False
+    s.run(1.2)
+    out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=2.0))
+    assert s.sup.state is S.LINK_LOST and any("ignored" in n.text for n in out.notes)
