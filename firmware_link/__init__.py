@@ -7,16 +7,29 @@
         link.rc_override(RcCommand(throttle_us=...))
     link.close()                                      # releases the overrides first
 
-Blocking helpers (`arm`, `set_mode`, `get_param`, `fetch_params`, `bring_up`) are for the
-loop's thread between ticks; `send_arm`/`send_disarm`/`send_set_mode` return at once and the
-outcome arrives as CommandAck / Heartbeat records. Errors are `LinkError` (exit 1) or
-`LinkUsageError` (exit 2), one line each.
+Opening identifies the firmware from what the vehicle says (`link.firmware`, a FirmwareInfo).
+Blocking helpers (`arm`, `set_mode`, `read_params`, `set_param`, `fetch_params`, `identify`,
+`bring_up`) are for the loop's thread between ticks; `send_arm`/`send_disarm`/`send_set_mode`
+and `rc_override` return at once (sends never block: see `tx_queue`) and the outcome arrives as
+CommandAck / Heartbeat records. Errors are `LinkError` (exit 1; `ParamError` for parameters) or
+`LinkUsageError` (exit 2), one line each. `.parm` files: `parm_file`.
 """
 
 from firmware_link.connection import ConnectionSpec, Transport, parse_connection_string
 from firmware_link.dialect import dialect_of_frame
 from firmware_link.errors import LinkError, LinkUsageError
+from firmware_link.firmware import FirmwareInfo
 from firmware_link.mocap_link import MocapLink
+from firmware_link.params import ParamError
+from firmware_link.parm_file import (
+    ParmFileError,
+    diff_params,
+    format_param_value,
+    parse_parm,
+    read_parm_file,
+    render_parm,
+    write_parm_file,
+)
 from firmware_link.signing import key_from_passphrase, load_signing_key
 from firmware_link.stats import LinkStats
 from firmware_link.streams import (
@@ -36,10 +49,13 @@ __all__ = [
     "BringUpStep",
     "ConnectionSpec",
     "DataStream",
+    "FirmwareInfo",
     "LinkError",
     "LinkStats",
     "LinkUsageError",
     "MocapLink",
+    "ParamError",
+    "ParmFileError",
     "StreamPlan",
     "StreamRate",
     "StreamWanted",
@@ -47,9 +63,15 @@ __all__ = [
     "VehicleLink",
     "clamp_pwm_us",
     "dialect_of_frame",
+    "diff_params",
+    "format_param_value",
     "key_from_passphrase",
     "load_signing_key",
     "parse_connection_string",
+    "parse_parm",
     "plan_streams",
+    "read_parm_file",
+    "render_parm",
     "wanted_streams",
+    "write_parm_file",
 ]

@@ -3,7 +3,8 @@
 Parsing uses pymavlink's MAVLink 2 parser (it reads MAVLink 1 frames too) in robust mode, so
 garbage and bad CRCs come back as BAD_DATA and are counted, never raised. Encoding uses the
 MAVLink 1 module for a MAVLink 1 vehicle (no extension fields, no signing) and the MAVLink 2
-module otherwise.
+module otherwise. Sending never blocks: messages wait in a `TxQueue` (an override slot and a
+bounded queue) and are packed, tapped and counted when the transport takes them.
 """
 
 from __future__ import annotations
@@ -12,9 +13,10 @@ import hashlib
 from collections.abc import Callable
 from typing import Any
 
-from firmware_link.protocol import WireVersion, mavlink, mavlink1
-from firmware_link.stats import StatsTally
+from firmware_link.protocol import WireVersion, frame_overhead_bytes, mavlink, mavlink1
+from firmware_link.stats import LinkStats, StatsTally
 from firmware_link.transport import ByteTransport, TransportClosed
+from firmware_link.tx_queue import TxQueue
 
 RawTap = Callable[[str, float, bytes], None]
 RX = "rx"
@@ -68,6 +70,7 @@ class FrameEndpoint:
         self.parser.robust_parsing = True
         self._encoder_v1 = mavlink1.MAVLink(_NoFile(), source_system, source_component)
         self.wire = WireVersion.V1
+        self.tx = TxQueue()
 
     @property
     def encoder(self) -> Any:
@@ -120,26 +123,76 @@ class FrameEndpoint:
             out.append(msg)
         return out
 
-    def send(self, msg: Any) -> bool:
-        """Encode and write one message; False (counted) when there is no transport."""
-        if self.transport is None:
+    def _frame_bytes(self, msg: Any) -> int:
+        """The largest frame `msg` packs to on the current wire (before packing it)."""
+        signed = self.wire is WireVersion.V2 and self.parser.signing.sign_outgoing
+        return int(msg.unpacker.size) + frame_overhead_bytes(self.wire, signed)
+
+    def _can_send(self) -> bool:
+        if self.transport is None or not self.transport.has_peer:
+            # no transport (reconnecting) or a udpin link before the vehicle has spoken:
+            # nowhere to send, and a stale command must not go out once there is
             self.tally.tx_dropped += 1
             return False
+        return True
+
+    def send(self, msg: Any) -> bool:
+        """Queue one message in order and write what the transport takes now.
+
+        False (counted in `tx_dropped`) when there is nowhere to send or the queue is full.
+        Raises TransportClosed when the transport failed for real.
+        """
+        if not self._can_send():
+            return False
+        if not self.tx.put(msg, self._frame_bytes(msg)):
+            self.tally.tx_dropped += 1
+            return False
+        self.flush()
+        return True
+
+    def send_override(self, msg: Any) -> bool:
+        """Put an RC override in the latest-override slot (replacing an unsent one) and write."""
+        if not self._can_send():
+            return False
+        self.tx.put_override(msg, self._frame_bytes(msg))
+        self.flush()
+        return True
+
+    def flush(self) -> int:
+        """Write what waits, as far as the transport takes it now; the bytes still waiting."""
+        transport = self.transport
+        if transport is None:
+            return 0
+        try:
+            self.tx.flush(self._pack, transport.write)
+        except TransportClosed:
+            self.tally.tx_dropped += self.tx.clear()
+            raise
+        return self.tx.queued_bytes
+
+    def discard_queue(self) -> None:
+        """Forget what waits (the transport it was meant for is gone)."""
+        self.tally.tx_dropped += self.tx.clear()
+
+    def _pack(self, msg: Any) -> bytes:
         encoder = self.encoder
         frame = bytes(msg.pack(encoder))
         encoder.seq = (encoder.seq + 1) % 256
         # Both encoders share one sequence so a dialect switch never looks like a gap.
         self._encoder_v1.seq = self.parser.seq = encoder.seq
-        try:
-            written = self.transport.write(frame)
-        except TransportClosed:
-            self.tally.tx_dropped += 1
-            raise
-        if not written:  # a udpin link before the vehicle has spoken: nowhere to send
-            self.tally.tx_dropped += 1
-            return False
         self.tally.tx_messages += 1
         self.tally.tx_bytes += len(frame)
         if self._on_raw is not None:
             self._on_raw(TX, self._clock(), frame)
-        return True
+        return frame
+
+    def snapshot(self, now_s: float) -> LinkStats:
+        """The counters, with the send queue's."""
+        q = self.tx
+        return self.tally.snapshot(
+            now_s,
+            tx_backpressure=q.backpressure,
+            tx_dropped_overrides=q.replaced_overrides,
+            tx_queue_overflows=q.overflows,
+            tx_queued_bytes=q.queued_bytes,
+        )

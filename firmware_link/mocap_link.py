@@ -76,7 +76,7 @@ class MocapLink:
     @property
     def stats(self) -> LinkStats:
         """A snapshot of the counters."""
-        return self._ep.tally.snapshot(self._clock())
+        return self._ep.snapshot(self._clock())
 
     def poll(self) -> list[MocapPose]:
         """Poses received since the last call (non-blocking)."""

@@ -20,9 +20,13 @@ class LinkStats:
     signature_refusals: int = 0  # frames refused: unsigned or badly signed while signing
     tx_messages: int = 0
     tx_bytes: int = 0
-    tx_dropped: int = 0  # messages not sent because the transport was down
+    tx_dropped: int = 0  # messages not sent: transport down, queue full, or lost with a port
     reconnects: int = 0
     rx_messages_per_s: float = 0.0  # over the last second
+    tx_backpressure: int = 0  # writes the transport cut short (full buffer, partial write)
+    tx_dropped_overrides: int = 0  # overrides replaced by a newer one before they went out
+    tx_queue_overflows: int = 0  # messages refused because the send queue was full
+    tx_queued_bytes: int = 0  # bytes waiting to be written when the snapshot was taken
 
 
 @dataclass
@@ -56,8 +60,17 @@ class StatsTally:
         """After a reconnect the sender's sequence restarts; a jump is not a loss."""
         self._last_seq.clear()
 
-    def snapshot(self, now_s: float) -> LinkStats:
-        """A frozen copy of the counters with the receive rate over the last second."""
+    def snapshot(
+        self,
+        now_s: float,
+        *,
+        tx_backpressure: int = 0,
+        tx_dropped_overrides: int = 0,
+        tx_queue_overflows: int = 0,
+        tx_queued_bytes: int = 0,
+    ) -> LinkStats:
+        """A frozen copy of the counters with the receive rate over the last second (the send
+        queue's counters live with the queue and are passed in)."""
         while self._recent_s and self._recent_s[0] < now_s - RATE_WINDOW_S:
             self._recent_s.popleft()
         return LinkStats(
@@ -72,4 +85,8 @@ class StatsTally:
             tx_dropped=self.tx_dropped,
             reconnects=self.reconnects,
             rx_messages_per_s=len(self._recent_s) / RATE_WINDOW_S,
+            tx_backpressure=tx_backpressure,
+            tx_dropped_overrides=tx_dropped_overrides,
+            tx_queue_overflows=tx_queue_overflows,
+            tx_queued_bytes=tx_queued_bytes,
         )

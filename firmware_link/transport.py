@@ -1,17 +1,20 @@
-"""Byte transports under the link: TCP, UDP in/out, serial (pyserial). Non-blocking reads.
+"""Byte transports under the link: TCP, UDP in/out, serial (pyserial). Non-blocking both ways.
 
 Every failure to open ends in one LinkError line naming the connection string. A TCP connect is
 bounded by `connect_timeout_s` (pymavlink would retry for ≈ 2 s); reopening after a loss uses a
 non-blocking connect so `poll()` never waits on it.
+
+`write()` takes what the medium accepts now and returns the count (0 when it is full); only a
+real error or hang-up raises TransportClosed. A full buffer is backpressure, not a lost port:
+the link keeps the rest queued (`tx_queue.TxQueue`) and flushes it on a later poll.
 """
 
 from __future__ import annotations
 
-import contextlib
 import errno
+import os
 import select
 import socket
-import time
 from typing import Protocol
 
 import serial
@@ -23,7 +26,12 @@ READ_CHUNK_BYTES = 65536
 # One poll() parses at most this much (≈ 10 ms of pymavlink work); a backlog after a stall is
 # worked off over the next ticks instead of stalling one of them.
 READ_BUDGET_BYTES = 16384
-WRITE_TIMEOUT_S = 0.5
+# The kernel's own send buffer is a queue the link cannot see or trim: Linux lets a TCP socket's
+# grow to megabytes, seconds of stale overrides behind a slow peer. A small one keeps the
+# backlog in the link's queue, where an override replaces the one before it.
+TCP_SEND_BUFFER_BYTES = 16384
+# errno values of a write that would block: backpressure, not an error
+_WOULD_BLOCK = (errno.EAGAIN, errno.EWOULDBLOCK, errno.EINTR)
 
 
 class TransportClosed(LinkError):
@@ -34,8 +42,11 @@ class ByteTransport(Protocol):
     """What the link needs from a transport."""
 
     def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes: ...
-    def write(self, data: bytes) -> bool: ...
+    def write(self, data: bytes | memoryview) -> int: ...
     def wait_readable(self, timeout_s: float) -> None: ...
+    def wait_writable(self, timeout_s: float) -> None: ...
+    @property
+    def has_peer(self) -> bool: ...
     def close(self) -> None: ...
     def fileno(self) -> int: ...
 
@@ -43,6 +54,11 @@ class ByteTransport(Protocol):
 def _wait(fd: int, timeout_s: float) -> None:
     if fd >= 0:
         select.select([fd], [], [], max(0.0, timeout_s))
+
+
+def _wait_out(fd: int, timeout_s: float) -> None:
+    if fd >= 0:
+        select.select([], [fd], [], max(0.0, timeout_s))
 
 
 class TcpTransport:
@@ -72,6 +88,7 @@ class TcpTransport:
     @classmethod
     def _ready(cls, spec: ConnectionSpec, sock: socket.socket) -> TcpTransport:
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, TCP_SEND_BUFFER_BYTES)
         # Non-blocking: a socket timeout would make recv() wait for it before giving up.
         sock.setblocking(False)
         return cls(spec, sock)
@@ -123,27 +140,28 @@ class TcpTransport:
             room -= len(data)
         return b"".join(chunks)
 
-    def write(self, data: bytes) -> bool:
-        """Send all of `data`; raises TransportClosed if the peer is gone."""
-        view = memoryview(data)
-        deadline = time.monotonic() + WRITE_TIMEOUT_S
-        while view:
-            try:
-                sent = self._sock.send(view)
-            except (BlockingIOError, InterruptedError):
-                remaining = deadline - time.monotonic()
-                if remaining <= 0:
-                    raise TransportClosed(f"{self.spec.url}: peer stopped reading") from None
-                select.select([], [self._sock], [], remaining)
-                continue
-            except OSError as exc:
-                raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
-            view = view[sent:]
+    def write(self, data: bytes | memoryview) -> int:
+        """Bytes of `data` the socket took now (0 when its buffer is full); raises
+        TransportClosed if the peer is gone."""
+        try:
+            return self._sock.send(data)
+        except (BlockingIOError, InterruptedError):
+            return 0
+        except OSError as exc:
+            raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
+
+    @property
+    def has_peer(self) -> bool:
+        """A connected socket always has its peer."""
         return True
 
     def wait_readable(self, timeout_s: float) -> None:
         """Block until bytes arrive or `timeout_s` passes."""
         _wait(self.fileno(), timeout_s)
+
+    def wait_writable(self, timeout_s: float) -> None:
+        """Block until the socket takes bytes again or `timeout_s` passes."""
+        _wait_out(self.fileno(), timeout_s)
 
     def fileno(self) -> int:
         """The socket's descriptor."""
@@ -203,18 +221,32 @@ class UdpTransport:
             room -= len(data)
         return b"".join(chunks)
 
-    def write(self, data: bytes) -> bool:
-        """Send one datagram to the peer (dropped until a udpin peer has spoken)."""
+    def write(self, data: bytes | memoryview) -> int:
+        """Send `data` as one datagram: all of it, or 0 to try the whole datagram again later."""
         if self._peer is None:
-            return False
-        # UDP is lossy by nature; the watchdog notices a dead peer.
-        with contextlib.suppress(OSError):
+            return 0
+        try:
             self._sock.sendto(data, self._peer)
-        return True
+        except (BlockingIOError, InterruptedError):
+            return 0
+        except OSError:
+            # UDP is lossy by nature (ICMP unreachable, no route): the datagram is gone, and
+            # the watchdog notices a dead peer.
+            pass
+        return len(data)
+
+    @property
+    def has_peer(self) -> bool:
+        """False on udpin until the vehicle has spoken: nowhere to send yet."""
+        return self._peer is not None
 
     def wait_readable(self, timeout_s: float) -> None:
         """Block until a datagram arrives or `timeout_s` passes."""
         _wait(self.fileno(), timeout_s)
+
+    def wait_writable(self, timeout_s: float) -> None:
+        """Block until the socket takes a datagram or `timeout_s` passes."""
+        _wait_out(self.fileno(), timeout_s)
 
     def fileno(self) -> int:
         """The socket's descriptor."""
@@ -240,7 +272,7 @@ class SerialTransport:
                 spec.device,
                 baudrate=spec.baud,
                 timeout=0,
-                write_timeout=WRITE_TIMEOUT_S,
+                write_timeout=0,
                 exclusive=True,
             )
         except serial.SerialException as exc:
@@ -273,17 +305,36 @@ class SerialTransport:
         except (serial.SerialException, OSError) as exc:
             raise TransportClosed(f"{self.spec.url}: serial device lost: {exc}") from None
 
-    def write(self, data: bytes) -> bool:
-        """Write all of `data`."""
+    def write(self, data: bytes | memoryview) -> int:
+        """Bytes of `data` the device took now (0 when its buffer is full).
+
+        pyserial opens the device non-blocking, but its `write()` with a zero write timeout
+        spins on EAGAIN; writing the descriptor directly returns instead.
+        """
+        fd = self.fileno()
+        if fd < 0:
+            raise TransportClosed(f"{self.spec.url}: serial device closed")
         try:
-            self._port.write(data)
-            return True
-        except (serial.SerialException, OSError) as exc:
+            return os.write(fd, data)
+        except BlockingIOError:
+            return 0
+        except OSError as exc:
+            if exc.errno in _WOULD_BLOCK:
+                return 0
             raise TransportClosed(f"{self.spec.url}: serial write failed: {exc}") from None
+
+    @property
+    def has_peer(self) -> bool:
+        """A serial line always has its far end (whether anyone listens is the watchdog's)."""
+        return True
 
     def wait_readable(self, timeout_s: float) -> None:
         """Block until bytes arrive or `timeout_s` passes."""
         _wait(self.fileno(), timeout_s)
+
+    def wait_writable(self, timeout_s: float) -> None:
+        """Block until the device takes bytes again or `timeout_s` passes."""
+        _wait_out(self.fileno(), timeout_s)
 
     def fileno(self) -> int:
         """The device's descriptor (-1 once closed)."""

@@ -1,7 +1,12 @@
 """A small MAVLink vehicle for link tests: heartbeats, streams, arming, modes, parameters.
 
 It stands in for the autopilot board (the one thing tests may mock) on a real TCP socket or a
-real pseudo-terminal, in a thread. It speaks MAVLink 1 ("apm25") or MAVLink 2 ("copter4").
+real pseudo-terminal, in a thread. It speaks MAVLink 1 ("apm25", as ArduCopter 3.2.1) or
+MAVLink 2 ("copter4", as ArduCopter 4.7), answering as the real firmware does where the station
+tells them apart: 3.2.1 refuses arming with UNSUPPORTED and a "PreArm:" text, refuses
+AUTOPILOT_VERSION requests and sends its version banner in reply to PARAM_REQUEST_LIST; 4.7
+refuses with FAILED, answers AUTOPILOT_VERSION and names its GCS id MAV_GCS_SYSID. `wire_v1`
+makes a copter4 speak MAVLink 1 (a 4.x port set to MAVLink 1).
 """
 
 from __future__ import annotations
@@ -18,6 +23,17 @@ from pymavlink.dialects.v10 import ardupilotmega as mav1
 from pymavlink.dialects.v20 import ardupilotmega as mav2
 
 ATTITUDE_ID = 30
+V4_7_DEV = (4 << 24) | (7 << 16) | (0 << 8) | 0  # flight_sw_version of 4.7.0-dev
+GIT_HASH = b"d2e4299f"
+PARAMS = {
+    "apm25": {"SYSID_MYGCS": 255.0, "FS_GCS_ENABLE": 1.0, "THR_MID": 500.0, "THR_MIN": 130.0},
+    "copter4": {"MAV_GCS_SYSID": 255.0, "FS_GCS_ENABLE": 0.0, "MOT_THST_HOVER": 0.39,
+                "ARMING_CHECK": 1.0, "ATC_RAT_RLL_P": 0.135},
+}
+INT_PARAMS = {"SYSID_MYGCS", "MAV_GCS_SYSID", "FS_GCS_ENABLE", "THR_MID", "THR_MIN",
+              "ARMING_CHECK"}
+BANNERS = {"apm25": ("ArduCopter V3.2.1", "Frame: QUAD"),
+           "copter4": ("ArduCopter V4.7.0-dev (d2e4299f)", "Frame: QUAD/X")}
 STREAM_MESSAGES = {10: ("ATTITUDE",), 1: ("RAW_IMU",), 12: ("RANGEFINDER", "DISTANCE_SENSOR")}
 
 
@@ -33,9 +49,11 @@ class PeerState:
     armed: bool = False
     mode: int = 0
     arm_refusal: str = ""  # non-empty: refuse arming with this STATUSTEXT
-    params: dict[str, float] = field(
-        default_factory=lambda: {"SYSID_MYGCS": 255.0, "FS_GCS_ENABLE": 1.0, "THR_MID": 500.0}
-    )
+    arm_refusals_left: int = -1  # with arm_refusal: refuse this many times, then arm (-1: always)
+    answers_version: bool = True  # copter4 answers AUTOPILOT_VERSION requests
+    sends_banner: bool = True  # the version banner in reply to PARAM_REQUEST_LIST
+    limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # clamps PARAM_SET
+    params: dict[str, float] = field(default_factory=dict)
     overrides: list[tuple[int, int, tuple[int, ...]]] = field(default_factory=list)  # sys, len
     rx_types: list[str] = field(default_factory=list)
     gcs_heartbeats: int = 0
@@ -54,15 +72,18 @@ class FakeVehicle:
         sysid: int = 1,
         signing_key: bytes | None = None,
         companion: bool = True,
+        wire_v1: bool = False,
+        rcvbuf: int | None = None,
     ) -> None:
         self.profile = profile
         self.sysid = sysid
-        self.state = PeerState()
+        self.state = PeerState(params=dict(PARAMS[profile]))
         self.paused = threading.Event()
+        self.stall_rx = threading.Event()  # set: stop reading what the station sends
         self._stop = threading.Event()
         self._lock = threading.Lock()
         self.companion = companion
-        self._v1 = profile == "apm25"
+        self._v1 = profile == "apm25" or wire_v1
         self._mav = mav2.MAVLink(_Sink(), sysid, 1)
         self._enc1 = mav1.MAVLink(_Sink(), sysid, 1)
         self._comp = mav2.MAVLink(_Sink(), sysid, 158)
@@ -85,6 +106,8 @@ class FakeVehicle:
         else:
             self._server = socket.socket()
             self._server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            if rcvbuf is not None:  # a small window fills fast when the reader stalls
+                self._server.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
             self._server.bind(("127.0.0.1", 0))
             self._server.listen(4)
             self.port = self._server.getsockname()[1]
@@ -167,6 +190,10 @@ class FakeVehicle:
         t0 = time.monotonic()
         while not self._stop.is_set():
             fds = self._fds()
+            if self.stall_rx.is_set():
+                with self._lock:
+                    server = self._server
+                fds = [server.fileno()] if server is not None and self._master < 0 else []
             try:
                 readable = select.select(fds, [], [], 0.001)[0] if fds else []
             except (OSError, ValueError):
@@ -220,7 +247,7 @@ class FakeVehicle:
                     # Keep the cadence: schedule from the due time, not from now.
                     next_msg[name] = max(due + 1.0 / hz, now - 0.05)
                     self._send_stream(name, now - t0)
-            if self.companion and not self._v1 and now >= next_comp:
+            if self.companion and self.profile == "copter4" and now >= next_comp:
                 next_comp = now + 0.1
                 self._send(
                     self._comp.distance_sensor_encode(0, 20, 50, 35, 0, 0, 0, 0), comp=True
@@ -233,9 +260,9 @@ class FakeVehicle:
             self._send(enc.attitude_encode(int(t * 1000), 0.01, -0.02, 1.0, 0.0, 0.0, 0.0))
         elif name == "RAW_IMU":
             self._send(enc.raw_imu_encode(int(t * 1e6), 10, -5, -1000, 1, 2, 3, 0, 0, 0))
-        elif name == "RANGEFINDER" and self._v1:
+        elif name == "RANGEFINDER" and self.profile == "apm25":
             self._send(enc.rangefinder_encode(0.75, 0.0))
-        elif name == "DISTANCE_SENSOR" and not self._v1:
+        elif name == "DISTANCE_SENSOR" and self.profile == "copter4":
             self._send(enc.distance_sensor_encode(int(t * 1000), 2, 400, 75, 1, 0, 25, 0))
 
     def _ack(self, command: int, result: int) -> None:
@@ -251,7 +278,8 @@ class FakeVehicle:
         st.rx_types.append(kind)
         enc = self._enc()
         if kind == "HEARTBEAT":
-            st.gcs_heartbeats += 1
+            if msg.type == 6:
+                st.gcs_heartbeats += 1
         elif kind == "RC_CHANNELS_OVERRIDE":
             st.overrides.append(
                 (msg.get_srcSystem(), len(msg.get_payload()), tuple(
@@ -259,21 +287,30 @@ class FakeVehicle:
             )
         elif kind == "SET_MODE":
             st.mode = msg.custom_mode
-            if not self._v1:
-                self._ack(11, 0)
+            self._ack(11, 0)  # both firmwares acknowledge SET_MODE as "command" 11
         elif kind == "REQUEST_DATA_STREAM":
             for name in STREAM_MESSAGES.get(msg.req_stream_id, ()):
                 st.rates_hz[name] = float(msg.req_message_rate) if msg.start_stop else 0.0
         elif kind == "COMMAND_LONG":
             if msg.command == 400:
-                if msg.param1 == 1 and st.arm_refusal and msg.param2 != 2989:
+                if (msg.param1 == 1 and st.arm_refusal and msg.param2 != 2989
+                        and st.arm_refusals_left != 0):
+                    st.arm_refusals_left -= 1 if st.arm_refusals_left > 0 else 0
                     self._send(enc.statustext_encode(3, st.arm_refusal.encode()))
-                    self._ack(400, 4)
+                    # 3.2.1 answers a refused arm UNSUPPORTED, 4.x FAILED
+                    self._ack(400, 3 if self.profile == "apm25" else 4)
                     return
                 st.armed = msg.param1 == 1
                 self._ack(400, 0)
                 self._send(enc.heartbeat_encode(2, 3, 81 | (128 * st.armed), st.mode, 3, 3))
-            elif msg.command == 511 and not self._v1:
+            elif msg.command in (512, 520) and self.profile == "copter4" and st.answers_version:
+                if msg.command == 512 and int(msg.param1) != 148:
+                    self._ack(512, 4)
+                    return
+                self._ack(msg.command, 0)
+                self._send(enc.autopilot_version_encode(
+                    0, V4_7_DEV, 0, 0, 0, list(GIT_HASH), [0] * 8, [0] * 8, 0, 0, 0))
+            elif msg.command == 511 and self.profile == "copter4":
                 names = {30: "ATTITUDE", 27: "RAW_IMU", 132: "DISTANCE_SENSOR"}
                 name = names.get(int(msg.param1))
                 if name is None:
@@ -291,9 +328,16 @@ class FakeVehicle:
                 self._param(name)
         elif kind == "PARAM_SET":
             if msg.param_id in st.params:
-                st.params[msg.param_id] = msg.param_value
+                value = msg.param_value
+                if msg.param_id in INT_PARAMS:
+                    value = float(int(value))
+                low, high = st.limits.get(msg.param_id, (-1e38, 1e38))
+                st.params[msg.param_id] = min(high, max(low, value))
                 self._param(msg.param_id)
         elif kind == "PARAM_REQUEST_LIST":
+            if st.sends_banner:
+                for text in BANNERS[self.profile]:
+                    self._send(enc.statustext_encode(6, text.encode()))
             for name in st.params:
                 self._param(name)
 
@@ -301,7 +345,8 @@ class FakeVehicle:
         names = list(self.state.params)
         self._send(
             self._enc().param_value_encode(
-                name.encode(), self.state.params[name], 9, len(names), names.index(name)
+                name.encode(), self.state.params[name], 4 if name in INT_PARAMS else 9,
+                len(names), names.index(name)
             )
         )
 
