@@ -19,6 +19,30 @@ class EstimatorParams:
     sonar_min_m: float = 0.02
     sonar_max_m: float = 4.0
     sonar_sigma_m: float = 0.01  # the HC-SR04's σ; tilt is corrected, late echoes re-timed
+    # Both firmwares report the range in whole centimetres (3.2.1's RANGEFINDER is a float of
+    # integer cm / 100, 4.x's DISTANCE_SENSOR a uint16 of cm): rounding adds a uniform error of
+    # ±resolution/2, σ = resolution/√12 ≈ 0.29 cm, to the sensor's own noise. 0 for a float range.
+    sonar_resolution_m: float = 0.01
+    # The HC-SR04 pings at most every 50 ms (20 Hz). The telemetry stream repeats its latest
+    # reading at the stream's rate (40 Hz here), and neither message says when the reading was
+    # taken (DISTANCE_SENSOR's time_boot_ms is the send time), so the same value arriving sooner
+    # than this after the last reading counted is the stream's repeat. 80 % of the period leaves
+    # room for arrival jitter on the link.
+    sonar_repeat_s: float = 0.04
+    # A same value arriving later is a new ping that landed in the same centimetre, unless the
+    # vehicle has, by the accelerometer, moved more than this since the value first
+    # appeared: then the sensor has not replaced its reading (over carpet an echo is still out)
+    # and the stream is repeating an old one. Resolution plus 2σ of the sensor's noise.
+    sonar_stale_move_m: float = 0.03
+    # ...plus this much per second the value has lasted: the accelerometer's own drift from a
+    # velocity known to a few cm/s, so that a long steady hover keeps its readings
+    sonar_stale_drift_mps: float = 0.03
+    # Over carpet a silent sensor (an echo still out) and a steady one look alike in the
+    # stream, and fusing a stale value as new pins the estimate to where the vehicle was. A
+    # sonar that lately lost an echo in the air (carpet loses a fifth of them) or, after a
+    # silence, read an altitude the vehicle had left, is doubted: for this long after, only a
+    # changed value is a new reading (as all were before whole centimetres).
+    sonar_doubt_s: float = 5.0
     # Per-sample vertical acceleration noise the Kalman filter assumes: the vibration on a 40 Hz
     # RAW_IMU (~0.5 m/s²) and some margin. Against the sonar this puts the filter's bandwidth,
     # (q/r)^¼ ≈ 7 rad/s, above the altitude loop's crossover (~4.6 rad/s). With 0.5 m/s² and a
@@ -60,6 +84,10 @@ class EstimatorParams:
         for name in positive:
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"{name} must be > 0")
+        for name in ("sonar_resolution_m", "sonar_repeat_s", "sonar_stale_move_m",
+                     "sonar_stale_drift_mps", "sonar_doubt_s"):
+            if getattr(self, name) < 0.0:
+                raise ValueError(f"{name} must be >= 0")
         if self.reacquire_count < 2:
             raise ValueError("reacquire_count must be >= 2")
 
@@ -71,7 +99,7 @@ class SonarStatus(enum.Enum):
     USED = "used"
     GROUND = "ground"  # zero reading near the floor, used as altitude 0
     INVALID = "invalid"  # out of range / zero in the air
-    DUPLICATE = "duplicate"  # the same reading again (stream faster than the sensor)
+    DUPLICATE = "duplicate"  # the stream repeating a reading the sensor has not replaced
     REJECTED = "rejected"  # failed the innovation gate (outlier, late echo)
     REACQUIRED = "reacquired"  # consistent readings after rejections: estimate reset to them
 
@@ -110,7 +138,17 @@ class AltEstimator(ABC):
         self._acc_up = 0.0
         self._last_sonar_t_s = -math.inf
         self._last_distance: float | None = None
-        self._last_new_t_s = -math.inf
+        self._last_new_t_s = -math.inf  # tick of the last reading counted as new
+        self._last_new_rx_s = -math.inf  # its message's receive stamp
+        # How far the vehicle has moved since the altitude the current sonar value measured, by
+        # the accelerometer alone from the velocity then: the sonar's own repeats must not pin
+        # the estimate that judges them (a stale value fused as new holds the filter still).
+        self._repeat_move_m = 0.0
+        self._repeat_vel_mps = 0.0
+        self._value_rx_s = -math.inf  # when the current value first arrived
+        self._doubt_until_s = -math.inf  # repeats are not readings until then (see sonar_doubt_s)
+        self._reading_late = False  # whether the last reading used was taken as a late echo
+        self._duplicates_total = 0
         self._history: deque[tuple[float, float]] = deque()  # (t_s, alt_m) after each predict
         self._rejected: deque[tuple[float, float]] = deque()  # (t_s, sonar alt), consecutive
         self._rejected_total = 0
@@ -158,6 +196,9 @@ class AltEstimator(ABC):
         self._t_s = t_s
         if dt > 0.0:
             self._predict(self._acc_up, dt)
+            a = self._acc_up - self._state()[2]
+            self._repeat_move_m += (self._repeat_vel_mps + 0.5 * a * dt) * dt
+            self._repeat_vel_mps += a * dt
         alt_before = self._state()[0]
         self._history.append((t_s, alt_before))
         while self._history[0][0] < t_s - p.history_s:
@@ -196,15 +237,48 @@ class AltEstimator(ABC):
                 return alt
         return self._history[0][1]
 
+    @property
+    def duplicates_total(self) -> int:
+        """Sonar messages taken for the stream's repeats of a reading already used."""
+        return self._duplicates_total
+
+    def _is_new_reading(self, d: float, t_s: float, alt_pred: float) -> bool:
+        """Whether a sonar message carries a reading the sensor took since the last one.
+
+        A changed value is new. A repeated one is new too once the sensor has had time to
+        ping again (`sonar_repeat_s`), as whole-centimetre readings of a steady hover mostly
+        repeat: with 3 mm of noise 85 % of the pings read the centimetre before. Only when the
+        vehicle has since moved further than a repeat allows is it the stream re-sending a
+        reading the sensor has not replaced, as over carpet while an echo is late."""
+        p = self.params
+        if d != self._last_distance:
+            return True
+        if t_s - self._last_new_rx_s < p.sonar_repeat_s or t_s < self._doubt_until_s:
+            return False
+        lasted_s = t_s - self._value_rx_s
+        return abs(self._repeat_move_m) <= p.sonar_stale_move_m + p.sonar_stale_drift_mps * lasted_s
+
     def _sonar(self, sonar: Rangefinder, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
         d = sonar.distance_m if sonar.valid else 0.0
-        # telemetry repeats the sensor's last reading at the stream rate: only a changed value
-        # is a new reading (a genuine repeat of the same value loses nothing)
-        fresh = d != self._last_distance
+        # the message's own arrival (receive stamp) times the repeat test; the tick's time
+        # (`t_s`) times everything the filter does with the reading
+        fresh = self._is_new_reading(d, sonar.t_s, alt_pred)
+        changed = d != self._last_distance
         prev_new_t_s = self._last_new_t_s
         if fresh:
             self._last_distance, self._last_new_t_s = d, t_s
+            self._last_new_rx_s = sonar.t_s
         result = self._use_reading(sonar, d, fresh, prev_new_t_s, t_s, alt_pred)
+        if changed and fresh:
+            # this value measured the altitude of now for a prompt reading, of its ping for a
+            # late echo (the clone still holds that until _on_ping)
+            alt, vel = self._state()[:2]
+            self._repeat_vel_mps = vel
+            self._value_rx_s = sonar.t_s
+            self._repeat_move_m = (self._late_shift(prev_new_t_s, alt)[0]
+                                   if self._reading_late else 0.0)
+        if result[0] is SonarStatus.DUPLICATE:
+            self._duplicates_total += 1
         if fresh:
             # the HC-SR04 sends its next ping as soon as an echo (or its timeout) is in
             self._on_ping(t_s)
@@ -246,7 +320,11 @@ class AltEstimator(ABC):
                 self._initialised = True
                 self._last_sonar_t_s = t_s
                 return SonarStatus.GROUND, p.rest_alt_m - alt_pred
+            if fresh and self._initialised:
+                # a lost echo in the air: carpet (or beyond range), where repeats mislead
+                self._doubt_until_s = sonar.t_s + p.sonar_doubt_s
             return SonarStatus.INVALID, 0.0
+        self._reading_late = False
         if not fresh:
             return SonarStatus.DUPLICATE, 0.0
         z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
@@ -254,6 +332,10 @@ class AltEstimator(ABC):
         # silence is a late echo of a ping sent about when the previous reading arrived
         # (carpet, thesis ch. 7): it measures the altitude of then, not of now.
         late = self._initialised and p.late_gap_s < t_s - prev_new_t_s <= p.late_max_s
+        self._reading_late = late
+        if late and abs(z - alt_pred) > p.sonar_stale_move_m:
+            # after a silence, the altitude of long ago: the sensor waits for late echoes here
+            self._doubt_until_s = sonar.t_s + p.sonar_doubt_s
         z_now = z + self._late_shift(prev_new_t_s, alt_pred)[0] if late else z
         innovation = z_now - alt_pred
         if not self._initialised:

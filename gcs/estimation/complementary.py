@@ -46,7 +46,7 @@ class ComplementaryEstimator(AltEstimator):
 
     def _correct(self, z_alt_m: float, t_s: float, extra_var_m2: float = 0.0) -> None:
         # a less certain reading drives the filter with a proportionally smaller error
-        r = self.params.sonar_sigma_m**2
+        r = self.params.sonar_sigma_m**2 + self.params.sonar_resolution_m**2 / 12.0
         self._err = (z_alt_m - (self._pos_base + self._pos_corr)) * r / (r + extra_var_m2)
         self._err_t_s = t_s
 

@@ -41,7 +41,8 @@ class KalmanEstimator(AltEstimator):
         self._P[0][0] = self._P[1][1] = 0.1**2
         self._P[2][2] = p.initial_bias_sigma_mps2**2
         self._clone()
-        self._R = p.sonar_sigma_m**2
+        # the sensor's noise and its whole-centimetre rounding (uniform: resolution²/12)
+        self._R = p.sonar_sigma_m**2 + p.sonar_resolution_m**2 / 12.0
         self._baro_started = False
 
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None:

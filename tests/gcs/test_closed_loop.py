@@ -14,6 +14,7 @@ import dataclasses
 from collections import deque
 
 import numpy as np
+import pytest
 
 from firmware_link.records import Attitude, Imu, Rangefinder
 from gcs.altitude_controller import AltitudeController, AltitudeControllerParams
@@ -27,8 +28,11 @@ LEVEL = Attitude(0.0, 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 def fly(params: EstimatorParams, seed: int, hold_s: float = 20.0,
-        step_s: float = 8.0) -> tuple[float, float]:
-    """Hold 1 m for `hold_s`, then step to 2 m; returns (hold RMS against truth, settle time)."""
+        step_s: float = 8.0, whole_cm: bool = False,
+        noise_m: float = 0.01) -> tuple[float, float]:
+    """Hold 1 m for `hold_s`, then step to 2 m; returns (hold RMS against truth, settle time).
+
+    `whole_cm`: the sonar reports whole centimetres, as both firmwares do."""
     rng = np.random.default_rng(seed)
     estimator = KalmanEstimator(params)
     ctrl = AltitudeController(AltitudeControllerParams(),
@@ -46,8 +50,9 @@ def fly(params: EstimatorParams, seed: int, hold_s: float = 20.0,
         if k % 2 == 0:
             outlier = rng.random() < 0.01
             reading = (rng.uniform(0.02, 4.0) if outlier
-                       else h - params.sonar_offset_m + rng.normal(0.0, 0.01))
-        sonar = Rangefinder(t, 1, reading, True, "RANGEFINDER")
+                       else h - params.sonar_offset_m + rng.normal(0.0, noise_m))
+        sent = round(reading * 100.0) / 100.0 if whole_cm else reading
+        sonar = Rangefinder(t, 1, sent, True, "RANGEFINDER")
         est = estimator.update(imu, sonar, LEVEL, t)
         if k == 0:
             ctrl.engage(est, None)
@@ -76,6 +81,18 @@ def test_hold_turns_little_sensor_noise_into_motion_and_the_step_settles() -> No
     rms = [r for r, _ in flights]
     assert max(rms) <= 0.015, rms
     assert max(s for _, s in flights) <= 4.0, flights
+
+
+@pytest.mark.parametrize("noise_m", [0.01, 0.003])
+def test_whole_cm_sonar_holds_as_well_as_unrounded(noise_m: float) -> None:
+    """The stream repeats each 20 Hz reading, rounded to the centimetre: with 3 mm of noise most
+    pings repeat the one before and must still count, or the filter coasts between changes."""
+    params = StationConfig().estimator
+    rms_whole = [fly(params, seed, whole_cm=True, noise_m=noise_m) for seed in range(6)]
+    rms_float = [fly(params, seed, noise_m=noise_m) for seed in range(6)]
+    assert max(r for r, _ in rms_whole) <= 0.015, rms_whole
+    assert max(s for _, s in rms_whole) <= 4.0, rms_whole
+    assert np.median([r for r, _ in rms_whole]) <= 1.2 * np.median([r for r, _ in rms_float])
 
 
 def test_a_filter_as_slow_as_the_loop_lets_the_vehicle_wander() -> None:
