@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from firmware_link import LinkError, LinkUsageError, MocapLink, VehicleLink, load_signing_key
+from firmware_link import LinkUsageError, MocapLink, ParamError, VehicleLink, load_signing_key
 from firmware_link.records import Battery, Dialect, MocapPose
 from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import load_config
@@ -177,10 +177,14 @@ class StationSession:
                                 on_raw=recorder.put_raw if recorder is not None else None)
         self._stack.callback(link.close)
         link.bring_up(STREAM_RATE_HZ)
-        params: dict[str, float] = {}
-        for name in CURVE_PARAMS.get(link.dialect, ()):
-            with contextlib.suppress(LinkError):
-                params[name] = link.get_param(name)
+        # The throttle curve is how the station turns a thrust into a stick: a default in place
+        # of the vehicle's own value would fly a wrong curve, so a failed read stops here.
+        names = CURVE_PARAMS.get(link.dialect, ())
+        try:
+            params = link.read_params(names)
+        except ParamError as exc:
+            raise ParamError(f"{exc} (the throttle curve needs {', '.join(exc.names)})",
+                             exc.names) from None
         curve = ThrottleCurve.for_dialect(link.dialect, params)
         mocap = None
         if mocap_url is not None:
