@@ -1,0 +1,490 @@
+"""One `quadgcs fly` through the fault proxy, watched from outside the link it breaks.
+
+The SITL runs as its own program; the station is the real CLI (`python -m gcs fly --connect
+<proxy> --json --live`), so what is tested is what a user runs. The fault hits only the vehicle
+link. Height comes from the motion-capture endpoint (which the fault does not touch), and the
+vehicle's arming state, mode and texts from a UDP endpoint of the SITL that only listens (it
+never sends a heartbeat, so it cannot keep the vehicle's GCS failsafe from firing).
+
+Times are the SITL's simulated seconds (mocap `time_usec`); what is stamped on the wall clock
+(heartbeats, the fault window) is mapped through the mocap stream's arrival times.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+import functools
+import json
+import os
+import select
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+from sitl.fault_frames import Counters, Direction
+from sitl.fault_proxy import FaultProxy
+
+ROOT = Path(__file__).resolve().parents[2]
+REST_ALT_M = 0.06  # the station's floor reference: its altitude of a vehicle standing on the floor
+SETPOINT_M = 1.0
+FAULT_AFTER_HOLD_S = 30.0
+MODE_LAND = 9
+FLOOR_BAND_M = 0.03  # within this of the resting altitude: on the floor
+OBSERVER_SYSID = 254  # not SYSID_MYGCS: its requests never count as the GCS being alive
+# Sped up, the serial line keeps its baud rate in simulated time, so it gets the smaller factor
+# (as the alt-hold e2e tests fly it).
+TCP_SPEEDUP, SERIAL_SPEEDUP = 4.0, 2.0
+REALTIME_WORKERS = 3
+
+
+@dataclass(frozen=True, slots=True)
+class FaultCase:
+    """A fault and the response the station's policy documents for it."""
+
+    name: str
+    direction: Direction
+    duration_s: float
+    drop: bool
+    loss: float = 0.0
+    bitflip: float = 0.0
+    documented: str = ""
+
+    @property
+    def lands(self) -> bool:
+        """A lost link must end in a landing; a lossy one must keep flying."""
+        return self.drop
+
+
+CASES: dict[str, FaultCase] = {c.name: c for c in (
+    FaultCase("downlink", Direction.DOWN, 15.0, True,
+              documented="station blind >1 s: requests LAND (uplink works), then goes quiet"),
+    FaultCase("uplink", Direction.UP, 15.0, True,
+              documented="vehicle hears nothing: its own GCS failsafe lands it"),
+    FaultCase("both", Direction.BOTH, 15.0, True,
+              documented="LAND requests lost; vehicle's failsafe lands it"),
+    FaultCase("lossy", Direction.BOTH, 60.0, False, loss=0.3, bitflip=0.05,
+              documented="30 % loss + 5 % flips: any frame is proof of life; keeps holding"),
+)}
+
+
+@dataclass
+class FlightResult:
+    """What happened, in simulated seconds, plus the numbers the suite asserts on."""
+
+    case: FaultCase
+    profile: str
+    transport: str
+    speedup: float
+    exit_code: int
+    stderr: str
+    summary: dict[str, Any] | None
+    phases: list[tuple[float, str]]  # (wall, phase) from --live
+    t_s: np.ndarray  # mocap times
+    alt_m: np.ndarray  # height, the station's floor reference (REST_ALT_M on the floor)
+    fault_start_s: float | None
+    fault_end_s: float | None
+    heartbeats: list[tuple[float, bool, int]]  # (sim t, armed, custom mode)
+    texts: list[tuple[float, str]]
+    params: dict[str, float]
+    up: Counters
+    down: Counters
+    wall_s: float
+
+    # ------------------------------------------------------------ derived numbers
+    @property
+    def reason(self) -> str:
+        """fly's last stderr line (its one-line reason when it failed)."""
+        lines = self.stderr.strip().splitlines()
+        return lines[-1] if lines else ""
+
+    @property
+    def airborne(self) -> np.ndarray:
+        """Mask of samples from the first take-off on."""
+        up = np.nonzero(self.alt_m > REST_ALT_M + 0.1)[0]
+        mask = np.zeros(self.alt_m.shape, bool)
+        if up.size:
+            mask[up[0]:] = True
+        return mask
+
+    @property
+    def max_over_setpoint_m(self) -> float:
+        """Highest height minus the setpoint (negative: never reached it)."""
+        return float(self.alt_m.max() - SETPOINT_M) if self.alt_m.size else float("nan")
+
+    def _after_fault(self) -> np.ndarray:
+        assert self.fault_start_s is not None
+        return self.t_s >= self.fault_start_s
+
+    @property
+    def touchdown_s(self) -> float | None:
+        """First time on the floor after the fault started (None: never, or no fault)."""
+        if self.fault_start_s is None:
+            return None
+        idx = np.nonzero(self._after_fault() & (self.alt_m <= REST_ALT_M + FLOOR_BAND_M))[0]
+        return float(self.t_s[idx[0]]) if idx.size else None
+
+    @property
+    def touchdown_speed_mps(self) -> float | None:
+        """Descent speed just before contact: the slope of the last 0.25 s above the floor."""
+        t_c = self.touchdown_s
+        if t_c is None:
+            return None
+        sel = (self.t_s >= t_c - 0.25) & (self.t_s <= t_c)
+        if sel.sum() < 3:
+            return None
+        slope = np.polyfit(self.t_s[sel] - t_c, self.alt_m[sel], 1)[0]
+        return float(max(0.0, -slope))
+
+    @property
+    def disarm_s(self) -> float | None:
+        """First sign of a disarm after the fault: a disarm text or a disarmed heartbeat."""
+        if self.fault_start_s is None:
+            return None
+        t0 = self.fault_start_s
+        hb = [t for t, armed, _ in self.heartbeats if t >= t0 and not armed]
+        txt = [t for t, text in self.texts if t >= t0 and "disarm" in text.lower()]
+        times = hb[:1] + txt[:1]
+        return min(times) if times else None
+
+    @property
+    def land_mode_s(self) -> float | None:
+        """First heartbeat in LAND after the fault (1 Hz: up to a second late)."""
+        if self.fault_start_s is None:
+            return None
+        ts = [t for t, _, mode in self.heartbeats if t >= self.fault_start_s and mode == MODE_LAND]
+        return ts[0] if ts else None
+
+    @property
+    def failsafe_texts(self) -> list[tuple[float, str]]:
+        """The vehicle's failsafe texts after the fault started."""
+        t0 = self.fault_start_s if self.fault_start_s is not None else float("inf")
+        return [(t, s) for t, s in self.texts if t >= t0 and "failsafe" in s.lower()]
+
+    @property
+    def open_loop_s(self) -> float | None:
+        """Seconds the vehicle flew on its last command before its own failsafe acted (only
+        when the uplink was dead: otherwise the station's LAND got through)."""
+        uplink_dead = self.case.drop and self.case.direction is not Direction.DOWN
+        if self.fault_start_s is None or not uplink_dead:
+            return None
+        starts = [t for t, _ in self.failsafe_texts]
+        if self.land_mode_s is not None:
+            starts.append(self.land_mode_s)
+        return (min(starts) - self.fault_start_s) if starts else None
+
+    @property
+    def open_loop_drift_m(self) -> tuple[float, float] | None:
+        """(height change, widest excursion) from the fault's start to the failsafe."""
+        dt = self.open_loop_s
+        if dt is None or self.fault_start_s is None:
+            return None
+        sel = (self.t_s >= self.fault_start_s) & (self.t_s <= self.fault_start_s + dt)
+        if not sel.any():
+            return None
+        seg = self.alt_m[sel]
+        return float(seg[-1] - seg[0]), float(np.max(np.abs(seg - seg[0])))
+
+    @property
+    def hold_during_fault_m(self) -> float | None:
+        """Worst |height - setpoint| while the fault lasted."""
+        if self.fault_start_s is None or self.fault_end_s is None:
+            return None
+        sel = (self.t_s >= self.fault_start_s) & (self.t_s <= self.fault_end_s)
+        return float(np.max(np.abs(self.alt_m[sel] - SETPOINT_M))) if sel.any() else None
+
+    def report(self) -> str:
+        """The run in a few lines, for assertion messages and the bench."""
+        def f(x: float | None, unit: str) -> str:
+            return "none" if x is None else f"{x:.2f}{unit}"
+        t0 = self.fault_start_s
+
+        def rel(t: float | None) -> float | None:
+            return None if t is None or t0 is None else t - t0
+
+        drift = self.open_loop_drift_m
+        return (f"{self.case.name}/{self.profile}/{self.transport} x{self.speedup:g}: exit "
+                f"{self.exit_code} ({self.reason!r}); fault at t={f(t0, ' s')}; max over "
+                f"setpoint {f(self.max_over_setpoint_m, ' m')}; touchdown "
+                f"{f(rel(self.touchdown_s), ' s')} after the fault at "
+                f"{f(self.touchdown_speed_mps, ' m/s')}; disarmed {f(rel(self.disarm_s), ' s')}"
+                f" after; LAND seen {f(rel(self.land_mode_s), ' s')} after; failsafe texts "
+                f"{[(round(t - (t0 or 0), 1), s) for t, s in self.failsafe_texts]}; open-loop "
+                f"{f(self.open_loop_s, ' s')}, drift {drift and tuple(round(d, 3) for d in drift)}"
+                f"; hold dev in fault {f(self.hold_during_fault_m, ' m')}; params "
+                f"{self.params}; proxy up [{self.up.line()}] down [{self.down.line()}]; "
+                f"{self.wall_s:.0f} s wall")
+
+
+# ------------------------------------------------------------------ watchers
+class MavWatcher:
+    """Reads MAVLink from a socket on its own thread and keeps what the suite needs."""
+
+    def __init__(self, sock: socket.socket, udp: bool) -> None:
+        self.sock = sock
+        self.udp = udp
+        self.mocap: list[tuple[float, float, float]] = []  # (wall, sim t, up m)
+        self.heartbeats: list[tuple[float, bool, int]] = []  # (wall, armed, mode)
+        self.texts: list[tuple[float, str]] = []
+        self.params: dict[str, float] = {}
+        self.peer: tuple[str, int] | None = None
+        self._mav = mavlink.MAVLink(None, srcSystem=OBSERVER_SYSID, srcComponent=191)
+        self._mav.robust_parsing = True
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True, name="mav-watch")
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            r, _, _ = select.select([self.sock], [], [], 0.05)
+            if not r:
+                continue
+            try:
+                data, addr = self.sock.recvfrom(65536)
+            except OSError:
+                return
+            if not data:
+                return
+            self.peer = addr if self.udp else self.peer
+            wall = time.monotonic()
+            for m in self._mav.parse_buffer(data) or []:
+                self._keep(m, wall)
+
+    def _keep(self, m: Any, wall: float) -> None:
+        kind = m.get_type()
+        if kind == "ATT_POS_MOCAP":
+            self.mocap.append((wall, m.time_usec * 1e-6, -m.z))
+        elif kind == "HEARTBEAT" and m.get_srcComponent() == 1:
+            self.heartbeats.append((wall, bool(m.base_mode & 128), int(m.custom_mode)))
+        elif kind == "STATUSTEXT":
+            self.texts.append((wall, m.text))
+        elif kind == "PARAM_VALUE":
+            self.params[m.param_id] = float(m.param_value)
+
+    def request_params(self, names: tuple[str, ...], timeout_s: float) -> dict[str, float]:
+        """Read parameters over this (UDP) endpoint, as an observer that is not the GCS."""
+        deadline = time.monotonic() + timeout_s
+        while self.peer is not None and time.monotonic() < deadline:
+            missing = [n for n in names if n not in self.params]
+            if not missing:
+                break
+            for n in missing:
+                msg = mavlink.MAVLink_param_request_read_message(1, 1, n.encode(), -1)
+                self.sock.sendto(msg.pack(self._mav), self.peer)
+            end = time.monotonic() + 0.3
+            while time.monotonic() < end and any(n not in self.params for n in missing):
+                time.sleep(0.02)  # the reader thread fills self.params
+        return {n: self.params[n] for n in names if n in self.params}
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(2.0)
+        self.sock.close()
+
+
+class SimClockMap:
+    """Wall time → simulated time, from the mocap stream's (arrival, time_usec) pairs."""
+
+    def __init__(self, mocap: list[tuple[float, float, float]]) -> None:
+        arr = np.array(mocap, dtype=float).reshape(-1, 3)
+        self.wall, self.sim = arr[:, 0], arr[:, 1]
+
+    def __call__(self, wall: float) -> float:
+        if self.wall.size == 0:
+            return float("nan")
+        return float(np.interp(wall, self.wall, self.sim))
+
+
+# ------------------------------------------------------------------ the run
+def _fly_accepts_speedup_with_connect() -> bool:
+    """Today's `fly` may refuse `--speedup` with `--connect` (a real vehicle flies in real time);
+    then these flights run in real time."""
+    done = subprocess.run([sys.executable, "-m", "gcs", "fly", "--connect", "tcp:127.0.0.1:1",
+                           "--speedup", "2", "--no-record", "--hold", "1"],
+                          capture_output=True, text=True, cwd=ROOT, timeout=60)
+    return not (done.returncode == 2 and "real time" in done.stderr)
+
+
+@functools.cache
+def speedup_allowed() -> bool:
+    """Asked once per process."""
+    return _fly_accepts_speedup_with_connect()
+
+
+@functools.cache
+def _fly_flags() -> frozenset[str]:
+    done = subprocess.run([sys.executable, "-m", "gcs", "fly", "--help"], capture_output=True,
+                          text=True, cwd=ROOT, timeout=60)
+    return frozenset(w.strip("[],") for w in done.stdout.split() if w.startswith(("--", "[--")))
+
+
+@contextlib.contextmanager
+def _sitl(args: list[str]) -> Iterator[Any]:
+    from tests.e2e.sitl_proc import SitlProcess
+
+    sitl = SitlProcess(args, cwd=ROOT)
+    try:
+        yield sitl
+    finally:
+        sitl.stop()
+
+
+def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
+                   speedup: float = 4.0, seed: int = 3) -> FlightResult:
+    """Fly 1.0 m, start `case` 30 s into the hold, watch until it is over; the result."""
+    if not speedup_allowed():
+        speedup = 1.0
+    wall0 = time.monotonic()
+    hold_s = FAULT_AFTER_HOLD_S + case.duration_s + (10.0 if case.lands else 8.0)
+    udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    udp.bind(("127.0.0.1", 0))
+    args = ["--tcp", "0", "--profile", profile, "--speedup", f"{speedup:g}", "--seed",
+            str(seed), "--udp", f"127.0.0.1:{udp.getsockname()[1]}"]
+    if transport == "serial":
+        args.append("--serial")
+    with contextlib.ExitStack() as stack:
+        sitl = stack.enter_context(_sitl(args))
+        watch_udp = MavWatcher(udp, udp=True)
+        stack.callback(watch_udp.close)
+        mocap_url = next(line.split(" ", 1)[1] for line in sitl.lines
+                         if line.startswith("mocap "))
+        host, port = mocap_url.removeprefix("tcp:").rsplit(":", 1)
+        watch_mocap = MavWatcher(socket.create_connection((host, int(port)), 5.0), udp=False)
+        stack.callback(watch_mocap.close)
+        if transport == "serial":
+            proxy = FaultProxy(serial_port=sitl.endpoint(1, "serial"), seed=seed,
+                               time_scale=speedup)
+            connect = f"{proxy.address},115200"
+        else:
+            h, p = sitl.endpoint(1, "tcp").rsplit(":", 1)
+            proxy = FaultProxy(target=(h, int(p)), seed=seed, time_scale=speedup)
+            connect = proxy.address
+        proxy.start()
+        stack.callback(proxy.stop)
+        argv = [sys.executable, "-m", "gcs", "fly", "--connect", connect, "--mocap", mocap_url,
+                "--profile", profile, "--alt", f"{SETPOINT_M}", "--hold", f"{hold_s:g}",
+                "--json", "--live", "--no-record"]
+        if speedup != 1.0:
+            argv += ["--speedup", f"{speedup:g}"]
+        if "--fix-failsafe" in _fly_flags():
+            argv.append("--fix-failsafe")  # the pilot's consent to set FS_GCS_* before flight
+        budget_s = (60.0 + hold_s + case.duration_s) / speedup + 30.0
+        run = _run_fly(argv, proxy, case, budget_s)
+        # keep watching: the vehicle may still be coming down after fly has given up
+        t_fault = run["fault_wall"]
+        if t_fault is not None:
+            end = t_fault + (case.duration_s + 25.0) / speedup
+            while time.monotonic() < end and not _disarmed_after(watch_udp, t_fault):
+                time.sleep(0.1)
+            time.sleep(min(2.0, max(0.0, end - time.monotonic())))
+        params = watch_udp.request_params(("FS_GCS_ENABLE", "FS_GCS_TIMEOUT"), 3.0)
+        clock = SimClockMap(watch_mocap.mocap)
+        mocap = np.array([(s, h) for _, s, h in watch_mocap.mocap], dtype=float).reshape(-1, 2)
+        t_s, up_m = mocap[:, 0], mocap[:, 1]
+        # the first second on the floor is the floor: heights in the station's reference
+        ground = up_m[t_s <= t_s[0] + 1.0] if t_s.size else up_m
+        alt_m = up_m - (float(np.median(ground)) if ground.size else 0.0) + REST_ALT_M
+        fault_end = None if t_fault is None else t_fault + case.duration_s / speedup
+        return FlightResult(
+            case=case, profile=profile, transport=transport, speedup=speedup,
+            exit_code=run["code"], stderr=run["stderr"], summary=run["summary"],
+            phases=run["phases"], t_s=t_s, alt_m=alt_m,
+            fault_start_s=None if t_fault is None else clock(t_fault),
+            fault_end_s=None if fault_end is None else clock(fault_end),
+            heartbeats=[(clock(w), a, m) for w, a, m in watch_udp.heartbeats],
+            texts=[(clock(w), s) for w, s in watch_udp.texts],
+            params=params, up=proxy.counters("up"), down=proxy.counters("down"),
+            wall_s=time.monotonic() - wall0)
+
+
+def _disarmed_after(w: MavWatcher, wall: float) -> bool:
+    return any(t > wall and not armed for t, armed, _ in w.heartbeats)
+
+
+def _run_fly(argv: list[str], proxy: FaultProxy, case: FaultCase,
+             budget_s: float) -> dict[str, Any]:
+    """Run fly; start the fault 30 s into its hold phase (seen on --live); collect output."""
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=ROOT, env=env)
+    out: dict[str, Any] = {"phases": [], "fault_wall": None, "summary": None}
+    stderr_lines: list[str] = []
+
+    def read_stdout() -> None:
+        assert proc.stdout is not None
+        last = ""
+        for line in proc.stdout:
+            word = line.split(" ", 1)[0]
+            if line.startswith("{"):
+                with contextlib.suppress(json.JSONDecodeError):
+                    out["summary"] = json.loads(line)
+            elif word and word != last and " alt " in line:
+                last = word
+                out["phases"].append((time.monotonic(), word))
+                if word == "hold" and out["fault_wall"] is None:
+                    w = proxy.schedule(case.direction, FAULT_AFTER_HOLD_S, case.duration_s,
+                                       drop=case.drop, loss=case.loss, bitflip=case.bitflip)
+                    out["fault_wall"] = proxy.monotonic_at(w.start_s)
+
+    readers = [threading.Thread(target=read_stdout, daemon=True),
+               threading.Thread(target=lambda: stderr_lines.extend(proc.stderr or []),
+                                daemon=True)]
+    for r in readers:
+        r.start()
+    try:
+        out["code"] = proc.wait(timeout=budget_s)
+    except subprocess.TimeoutExpired:
+        proc.terminate()  # fly lands a flying vehicle on SIGTERM before it lets go
+        try:
+            proc.wait(timeout=15.0)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+        out["code"] = -1
+        stderr_lines.append(f"(fly did not end within {budget_s:.0f} s of wall time)\n")
+    for r in readers:
+        r.join(5.0)
+    out["stderr"] = "".join(stderr_lines)
+    if out["fault_wall"] is not None and out["fault_wall"] > time.monotonic():
+        out["fault_wall"] = None  # fly ended before the fault began: there was no fault
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class FlightSpec:
+    """One flight of the matrix."""
+
+    case: str
+    profile: str
+    transport: str = "tcp"
+
+    @property
+    def id(self) -> str:
+        """A short name (pytest ids, the bench's rows)."""
+        return f"{self.case}-{self.profile}-{self.transport}"
+
+
+def run_many(specs: list[FlightSpec], seed: int = 3) -> dict[FlightSpec, FlightResult]:
+    """Fly every spec: one after another when sped up (each then needs about a core), three
+    at a time in real time (each needs about a quarter of one), longest first."""
+    if not specs:
+        return {}
+    speedup_ok = speedup_allowed()
+
+    def one(spec: FlightSpec) -> FlightResult:
+        k = (TCP_SPEEDUP if spec.transport == "tcp" else SERIAL_SPEEDUP) if speedup_ok else 1.0
+        return fly_with_fault(CASES[spec.case], spec.profile, spec.transport, k, seed)
+
+    order = sorted(specs, key=lambda s: -CASES[s.case].duration_s)
+    workers = 1 if speedup_ok else REALTIME_WORKERS
+    with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
+        return dict(zip(order, pool.map(one, order), strict=True))

@@ -1,0 +1,91 @@
+"""`quadgcs fly` through a fault injector: the link dies one way, both ways, or turns lossy.
+
+Each flight: the SITL (its own program), the fault proxy between it and the station, and the
+real CLI `quadgcs fly --connect <proxy> --mocap <sitl mocap> --json`, holding 1.0 m. Thirty
+seconds into the hold the fault starts. Height is judged from motion capture, which the fault
+does not touch; the vehicle's arming state, mode and failsafe texts from a UDP endpoint of the
+SITL that only listens.
+
+What the station's policy promises: proof of life is any frame; a short gap holds a safe
+command; a gap over ~1 s makes it request LAND for a few seconds, then stop heartbeats and
+overrides so the autopilot's own failsafe acts if the uplink is dead too; nothing resumes when
+the link returns. So for a lost link, one way or both: never above setpoint + 0.3 m, touchdown
+no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault, and `fly` exits 3
+with a reason line. With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m and exits 0.
+
+The matrix is flown once per session (a module fixture, only the selected cases): sped up and
+one at a time when `fly` takes `--speedup` with `--connect`, else in real time three at a time.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from sitl.fault_frames import Direction
+from tests.e2e.fault_flight import CASES, FlightResult, FlightSpec, run_many
+
+pytestmark = [pytest.mark.e2e, pytest.mark.timeout(900)]
+
+MATRIX = [
+    *(FlightSpec(case, profile) for case in ("downlink", "uplink", "both", "lossy")
+      for profile in ("apm25", "copter4")),
+    # the product's own case: an APM 2.5 on its 115200-baud radio, out of range
+    FlightSpec("both", "apm25", "serial"),
+]
+MAX_OVER_SETPOINT_M = 0.3
+MAX_TOUCHDOWN_MPS = 1.0
+DOWN_AND_DISARMED_S = 20.0
+LOSSY_HOLD_M = 0.1
+FLIGHT_FAILED_EXIT = 3
+
+
+@pytest.fixture(scope="module")
+def flights(request: pytest.FixtureRequest) -> dict[FlightSpec, FlightResult]:
+    """Every selected flight of this module, flown together."""
+    wanted = [item.callspec.params["spec"] for item in request.session.items
+              if item.module is request.module and hasattr(item, "callspec")]
+    return run_many(wanted)
+
+
+def _problems(r: FlightResult) -> list[str]:
+    c = r.case
+    out: list[str] = []
+    if r.fault_start_s is None:
+        return [f"the fault never started (fly ended first: exit {r.exit_code}, {r.reason!r})"]
+    if not r.max_over_setpoint_m <= MAX_OVER_SETPOINT_M:
+        out.append(f"rose {r.max_over_setpoint_m:.2f} m over the setpoint")
+    if c.lands:
+        down = r.touchdown_s
+        if down is None or down - r.fault_start_s > DOWN_AND_DISARMED_S:
+            out.append(f"not on the floor within {DOWN_AND_DISARMED_S:g} s of the fault")
+        speed = r.touchdown_speed_mps
+        if speed is not None and not speed <= MAX_TOUCHDOWN_MPS:
+            out.append(f"touched down at {speed:.2f} m/s")
+        off = r.disarm_s
+        if off is None or off - r.fault_start_s > DOWN_AND_DISARMED_S:
+            out.append(f"not disarmed within {DOWN_AND_DISARMED_S:g} s of the fault")
+        if r.exit_code != FLIGHT_FAILED_EXIT or not r.reason.startswith("quadgcs fly: "):
+            out.append(f"fly exited {r.exit_code} with {r.reason!r}, expected "
+                       f"{FLIGHT_FAILED_EXIT} and a reason line")
+        if c.direction is not Direction.DOWN and r.land_mode_s is None and not r.failsafe_texts:
+            out.append("the vehicle's own failsafe never acted (no LAND, no failsafe text)")
+    else:
+        dev = r.hold_during_fault_m
+        if dev is None or not dev <= LOSSY_HOLD_M:
+            out.append(f"held only within ±{dev if dev is None else round(dev, 3)} m")
+        if r.exit_code != 0:
+            out.append(f"fly exited {r.exit_code} with {r.reason!r} on a flight that went as "
+                       "commanded")
+        if not (r.up.frames_corrupted and r.down.frames_corrupted and r.down.frames_dropped):
+            out.append("the proxy never lost or corrupted a frame: no fault was tested")
+    return out
+
+
+@pytest.mark.parametrize("spec", MATRIX, ids=[s.id for s in MATRIX])
+def test_station_survives_the_fault(spec: FlightSpec,
+                                    flights: dict[FlightSpec, FlightResult]) -> None:
+    r = flights[spec]
+    print(r.report())  # the numbers, kept for -rP / the log even when the case passes
+    assert CASES[spec.case] is r.case
+    problems = _problems(r)
+    assert not problems, "; ".join(problems) + "\n" + r.report()
