@@ -1,24 +1,32 @@
 """A scripted flight under the PC controller: arm, take off, hold, optional step, land, disarm.
 
 This is the thesis's Chapter 7 experiment as a procedure: it drives a running `Station` through
-intents, records one sample per tick through a station listener, and scores the hold (RMS and
-worst altitude error, against the SITL's ground truth when the vehicle sends it, else against
-the station's own estimate) and the step (overshoot, settling time).
+intents, records one sample per tick through a station listener, and scores the hold (RMS, bias,
+spread and worst altitude error) and the step (overshoot, settling time) with `gcs.scoring`:
+against the SITL's ground truth where the vehicle sends it, saying how much of the hold it
+covered; against the station's own estimate only when there is no truth at all, and saying so.
 """
 
 from __future__ import annotations
 
 import enum
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from firmware_link.records import FlightMode
 from gcs.errors import FlightFailed
 from gcs.position_controller import PositionSetpoint, yaw_from_quat
+from gcs.scoring import (
+    ESTIMATE,
+    TRUTH,
+    Series,
+    StepMetrics,
+    distinct_reports,
+    score_hold,
+    step_response,
+)
+from gcs.scoring import truth_origin_m as _truth_origin
 from gcs.station import Station, StationSnapshot
 from gcs.supervisor import SupervisorState
 
@@ -66,21 +74,6 @@ class FlightSample:
 
 
 @dataclass(frozen=True, slots=True)
-class StepMetrics:
-    """Response to a setpoint step.
-
-    The settling time is the last time the altitude, averaged over `step_smooth_s` (0.5 s), is
-    outside ±band of the target. The average keeps the vehicle's ~2–3 cm RMS hover wobble from
-    deciding a ±5 cm band test by a single 25 ms sample; overshoot uses the raw altitude.
-    """
-
-    step_m: float
-    overshoot_pct: float
-    settle_time_s: float  # last time outside ±band, from the step (inf if never settled)
-    band_m: float
-
-
-@dataclass(frozen=True, slots=True)
 class FlightPlan:
     """What to fly."""
 
@@ -115,9 +108,13 @@ class FlightPlan:
 class FlightSummary:
     """The flight's score card."""
 
-    rms_error_m: float
+    rms_error_m: float  # hold: against the setpoint; rms² = mean² + std²
     max_error_m: float
-    error_source: str  # "truth" or "estimate"
+    error_source: str  # "truth", "estimate" (no truth at all) or "none"
+    mean_error_m: float  # the hold's bias (altitude minus setpoint)
+    std_error_m: float  # its spread about that bias
+    truth_coverage: float  # share of the hold with a current truth report (0..1)
+    truth_rate_hz: float  # distinct truth reports per second in the hold
     step: StepMetrics | None
     jitter_p50_ms: float
     jitter_p99_ms: float
@@ -129,10 +126,6 @@ class FlightSummary:
     corrupted: int
     hover_throttle: float
     samples: tuple[FlightSample, ...] = field(repr=False)
-
-
-def _finite(x: float | None) -> bool:
-    return x is not None and math.isfinite(x)
 
 
 def _truth_alt(snap: StationSnapshot) -> float | None:
@@ -310,23 +303,29 @@ class FlightRunner:
         self.phase = Phase.DONE
 
     # -------------------------------------------------------------- scoring
-    def summary(self) -> FlightSummary:
-        """Score the flight from the samples and the station's statistics."""
+    def summary(self, truth: Series | None = None) -> FlightSummary:
+        """Score the flight from the samples and the station's statistics.
+
+        `truth`: altitudes above the floor from an evaluation-only truth feed (the SITL's truth
+        endpoint), stamped with the station's clock. Without it, the SIM_STATE reports the
+        vehicle sent on its link, where it sent them."""
         snap = self.station.snapshot()
         hold = [s for s in self.samples if s.phase is Phase.HOLD and s.setpoint_m is not None]
-        use_truth = (bool(hold) and self.truth_origin_m() is not None
-                     and all(_finite(s.truth_alt_m) for s in hold))
-        errs = np.array([self._alt(s, use_truth) - (s.setpoint_m or 0.0) for s in hold])
-        rms = float(np.sqrt(np.mean(errs**2))) if errs.size else math.nan
-        worst = float(np.max(np.abs(errs))) if errs.size else math.nan
-        step = self._step_metrics(use_truth)
+        truth = truth if truth is not None else self._link_truth()
+        score = score_hold([s.t_s for s in hold], [s.setpoint_m or 0.0 for s in hold],
+                           [s.est_alt_m for s in hold], truth)
+        e = score.errors
         ls = snap.loop
         stats = snap.link_stats
         return FlightSummary(
-            rms_error_m=rms,
-            max_error_m=worst,
-            error_source="truth" if use_truth else "estimate",
-            step=step,
+            rms_error_m=e.rms_m,
+            max_error_m=e.max_m,
+            error_source=score.source,
+            mean_error_m=e.mean_m,
+            std_error_m=e.std_m,
+            truth_coverage=score.truth_coverage,
+            truth_rate_hz=score.truth_rate_hz,
+            step=self._step_metrics(score.source, truth),
             jitter_p50_ms=ls.jitter_p50_s * 1e3,
             jitter_p99_ms=ls.jitter_p99_s * 1e3,
             compute_p99_ms=ls.compute_p99_s * 1e3,
@@ -340,37 +339,38 @@ class FlightRunner:
         )
 
     def truth_origin_m(self) -> float | None:
-        """Offset to subtract from reported truth altitudes (from the samples on the floor)."""
-        ground = [s.truth_alt_m for s in self.samples
-                  if s.phase is Phase.GROUND and _finite(s.truth_alt_m)]
-        if not ground:
+        """Offset to subtract from SIM_STATE truth altitudes (relative to the vehicle's first
+        report): from the samples on the floor, where the centre of gravity stands at
+        `rest_alt_m`. A truth feed measured from the floor needs none."""
+        return _truth_origin([s.truth_alt_m for s in self.samples if s.phase is Phase.GROUND],
+                             self.rest_alt_m)
+
+    def _link_truth(self) -> Series | None:
+        """The SIM_STATE reports in the samples, one point per report, above the floor."""
+        origin = self.truth_origin_m()
+        if origin is None:
             return None
-        return float(np.median(np.array(ground, dtype=float))) - self.rest_alt_m
+        reports = distinct_reports([s.t_s for s in self.samples],
+                                   [s.truth_alt_m for s in self.samples])
+        return Series(reports.t_s, reports.alt_m - origin)
 
-    def _alt(self, s: FlightSample, use_truth: bool) -> float:
-        if use_truth:
-            origin = self.truth_origin_m()
-            assert origin is not None and s.truth_alt_m is not None
-            return s.truth_alt_m - origin
-        return s.est_alt_m if s.est_alt_m is not None else math.nan
+    def _alt(self, source: str, truth: Series | None, t0_s: float, t1_s: float) -> Series | None:
+        """The altitude the score's source saw over [t0_s, t1_s]."""
+        if source == TRUTH and truth is not None:
+            return truth.between(t0_s, t1_s)
+        if source == ESTIMATE:
+            part = [s for s in self.samples if t0_s <= s.t_s <= t1_s and s.est_alt_m is not None]
+            return Series.of([s.t_s for s in part], [s.est_alt_m or 0.0 for s in part])
+        return None
 
-    def _step_metrics(self, use_truth: bool) -> StepMetrics | None:
+    def _step_metrics(self, source: str, truth: Series | None) -> StepMetrics | None:
         p = self.plan
         step = [s for s in self.samples if s.phase is Phase.STEP]
         if not p.step_m or not step:
             return None
-        t0 = step[0].t_s
-        target = p.alt_m + p.step_m
-        alts = np.array([self._alt(s, use_truth) for s in step])
-        ts = np.array([s.t_s - t0 for s in step])
-        beyond = (alts - target) * math.copysign(1.0, p.step_m)
-        overshoot = max(0.0, float(beyond.max())) / abs(p.step_m) * 100.0
-        n = max(1, round(p.step_smooth_s / max(float(np.median(np.diff(ts))), 1e-3)))
-        smooth = np.convolve(alts, np.ones(n) / n, mode="same") if alts.size > n else alts
-        # the edges of a "same" convolution average in zeros: judge only the valid middle
-        valid = slice(n // 2, alts.size - n // 2) if alts.size > n else slice(None)
-        outside = ts[valid][np.abs(smooth[valid] - target) > p.step_band_m]
-        settle = float(outside.max()) if outside.size else 0.0
-        if outside.size and outside.max() >= ts[valid][-1] - 1e-9:
-            settle = math.inf
-        return StepMetrics(p.step_m, overshoot, settle, p.step_band_m)
+        series = self._alt(source, truth if truth is not None else self._link_truth(),
+                           step[0].t_s, step[-1].t_s)
+        if series is None:
+            return None
+        return step_response(series, step[0].t_s, p.alt_m + p.step_m, p.step_m, p.step_band_m,
+                             p.step_smooth_s)

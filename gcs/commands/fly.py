@@ -81,11 +81,20 @@ class LivePrinter:
         )
 
 
+def _metres(x: float) -> float | None:
+    """A score for JSON: rounded to 0.1 mm, None when there was nothing to score."""
+    return round(x, 4) if math.isfinite(x) else None
+
+
 def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> dict[str, Any]:
     d: dict[str, Any] = {
-        "rms_error_m": round(s.rms_error_m, 4),
-        "max_error_m": round(s.max_error_m, 4),
+        "rms_error_m": _metres(s.rms_error_m),
+        "max_error_m": _metres(s.max_error_m),
+        "mean_error_m": _metres(s.mean_error_m),
+        "std_error_m": _metres(s.std_error_m),
         "error_source": s.error_source,
+        "truth_coverage": round(s.truth_coverage, 3),
+        "truth_rate_hz": round(s.truth_rate_hz, 1),
         "jitter_p50_ms": round(s.jitter_p50_ms, 3),
         "jitter_p99_ms": round(s.jitter_p99_ms, 3),
         "compute_p99_ms": round(s.compute_p99_ms, 3),
@@ -110,8 +119,16 @@ def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> 
 
 
 def _print_summary(d: dict[str, Any]) -> None:
-    print(f"altitude hold ({d['error_source']}): RMS error {d['rms_error_m'] * 100:.1f} cm, "
-          f"worst {d['max_error_m'] * 100:.1f} cm")
+    source = d["error_source"]
+    if source == "none":
+        print("altitude hold: not scored (no ground truth and no estimate during the hold)")
+    else:
+        against = (f"vs truth ({d['truth_coverage'] * 100:.0f} % of the hold, "
+                   f"{d['truth_rate_hz']:.0f} Hz)" if source == "truth"
+                   else "vs the station's own estimate (no truth: the controller's error only)")
+        print(f"altitude hold {against}: RMS {d['rms_error_m'] * 100:.2f} cm = bias "
+              f"{d['mean_error_m'] * 100:+.2f} cm, std {d['std_error_m'] * 100:.2f} cm; "
+              f"worst {d['max_error_m'] * 100:.1f} cm")
     if "step" in d:
         st = d["step"]
         settle = "never" if st["settle_time_s"] is None else f"{st['settle_time_s']:.2f} s"
