@@ -55,13 +55,18 @@ class FirmwareInfo:
     version_number: tuple[int, int, int] | None = None
 
     @property
+    def name(self) -> str:
+        """The version text, or the family when the vehicle gave no version."""
+        family = {Dialect.APM25: "ArduCopter 3.x", Dialect.COPTER4: "ArduCopter 4.x"}
+        return self.version or family.get(self.dialect, "unknown firmware")
+
+    @property
     def summary(self) -> str:
         """One line: version (or family), dialect, wire and GCS-id parameter."""
-        family = {Dialect.APM25: "ArduCopter 3.x", Dialect.COPTER4: "ArduCopter 4.x"}
-        name = self.version or f"{family.get(self.dialect, 'unknown firmware')} (no version given)"
+        given = "" if self.version else " (no version given)"
         return (
-            f"{name}: dialect {self.dialect.name}, MAVLink {int(self.wire)} on this port, "
-            f"GCS id in {self.gcs_sysid_param}"
+            f"{self.name}{given}: dialect {self.dialect.name}, MAVLink {int(self.wire)} on this "
+            f"port, GCS id in {self.gcs_sysid_param}"
         )
 
 

@@ -49,9 +49,11 @@ class PeerState:
     armed: bool = False
     mode: int = 0
     arm_refusal: str = ""  # non-empty: refuse arming with this STATUSTEXT
+    arm_refusal_silent: bool = False  # refuse arming with no text (3.2.1, throttle not low)
     arm_refusals_left: int = -1  # with arm_refusal: refuse this many times, then arm (-1: always)
     answers_version: bool = True  # copter4 answers AUTOPILOT_VERSION requests
     sends_banner: bool = True  # the version banner in reply to PARAM_REQUEST_LIST
+    heartbeats: bool = True  # False: streams and replies go on, HEARTBEAT does not
     limits: dict[str, tuple[float, float]] = field(default_factory=dict)  # clamps PARAM_SET
     params: dict[str, float] = field(default_factory=dict)
     overrides: list[tuple[int, int, tuple[int, ...]]] = field(default_factory=list)  # sys, len
@@ -235,7 +237,7 @@ class FakeVehicle:
             now = time.monotonic()
             if self.paused.is_set():
                 continue
-            if now >= next_hb:
+            if now >= next_hb and self.state.heartbeats:
                 next_hb = now + 1.0
                 base = 81 | (128 if self.state.armed else 0)
                 self._send(self._enc().heartbeat_encode(2, 3, base, self.state.mode, 3, 3))
@@ -293,10 +295,11 @@ class FakeVehicle:
                 st.rates_hz[name] = float(msg.req_message_rate) if msg.start_stop else 0.0
         elif kind == "COMMAND_LONG":
             if msg.command == 400:
-                if (msg.param1 == 1 and st.arm_refusal and msg.param2 != 2989
-                        and st.arm_refusals_left != 0):
+                if (msg.param1 == 1 and (st.arm_refusal or st.arm_refusal_silent)
+                        and msg.param2 != 2989 and st.arm_refusals_left != 0):
                     st.arm_refusals_left -= 1 if st.arm_refusals_left > 0 else 0
-                    self._send(enc.statustext_encode(3, st.arm_refusal.encode()))
+                    if st.arm_refusal:
+                        self._send(enc.statustext_encode(3, st.arm_refusal.encode()))
                     # 3.2.1 answers a refused arm UNSUPPORTED, 4.x FAILED
                     self._ack(400, 3 if self.profile == "apm25" else 4)
                     return
