@@ -15,7 +15,8 @@ import sys
 from collections.abc import Sequence
 from types import FrameType
 
-from sitl.autopilot import Profile
+from sitl.autopilot import AutopilotOptions, Profile
+from sitl.autopilot.profile import COPTER4_VERSIONS
 from sitl.link.codec import SigningKeyError, load_signing_key
 from sitl.link.endpoints import EndpointError
 from sitl.link.server import TCP_BASE_PORT, EndpointPlan, SitlServer
@@ -101,6 +102,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--no-noise", action="store_true", help="perfect sensors (tests only)")
     parser.add_argument(
+        "--realistic-boot",
+        action="store_true",
+        help="copter4: refuse to arm for the real ≈24 s after boot (default ≈3 s); also "
+        "[autopilot] realistic_boot in the world file",
+    )
+    parser.add_argument(
+        "--copter4-version",
+        choices=COPTER4_VERSIONS,
+        help="copter4 parameter names: 4.7 (MAV_GCS_SYSID, MAVn_*; default) or 4.6 for any "
+        "4.x before 4.7 (SYSID_MYGCS, SRn_*); also [autopilot] copter4_version",
+    )
+    parser.add_argument(
+        "--truth-port",
+        type=_port,
+        metavar="PORT",
+        help="open a ground-truth TCP endpoint for scoring (LOCAL_POSITION_NED at 50 Hz, "
+        "sysid 201; 0 = OS-chosen); printed as `truth tcp:...`",
+    )
+    parser.add_argument(
         "--mocap-port",
         type=_port,
         metavar="PORT",
@@ -114,7 +134,16 @@ What a ground station sees:
   autopilot       sysid 1..N, compid 1; HEARTBEAT at 1 Hz; nothing else streams until
                   REQUEST_DATA_STREAM (both profiles) or SET_MESSAGE_INTERVAL (copter4).
                   apm25 = ArduCopter 3.2.1 (MAVLink 1 only); copter4 = ArduCopter 4.x.
-  stream params   SR0_* for the TCP link, SR1_* for the serial port, SR2_* for UDP.
+  stream params   SR0_* for the TCP link, SR1_* for the serial port, SR2_* for UDP
+                  (copter4 4.7: MAV1_*, MAV2_*, MAV3_*).
+  parameters      the real firmware's lists: 412 (3.2.1), 1364 (4.7).
+  ALL stream      3.2.1: 21 types at 50/(int(50/rate)+1) Hz (25 Hz at most); 4.7: 29 types
+                  at the rate asked (see sitl/README.md).
+  arming          apm25: refusals COMMAND_ACK UNSUPPORTED (3), "PreArm: INS not calibrated"
+                  for 3 s after boot; the ACK comes 1.9 s after the command, streams paused.
+                  copter4: FAILED (4) with "Arm: ..." ("Arm: Accels inconsistent" for 3 s,
+                  24 s with --realistic-boot); motors stopped 2 s after arming, then spool up
+                  over MOT_SPOOL_TIME.
   RAW_IMU         acceleration in mg, rates in mrad/s (as ArduPilot sends them).
   companion       compid 158 on each vehicle link, once a GCS has spoken: six IR
                   DISTANCE_SENSOR (orientations 0,2,4,6,24,25; 51 cm = nothing in range)
@@ -124,8 +153,12 @@ What a ground station sees:
                   capped at 10 Hz on the serial port so it leaves the 115200-baud budget
                   to the control streams. No SIMSTATE (it has no altitude).
   serial port     MAVLink 1 frames (apm25) carry base payloads only, as a real v1 sender.
-  FS_GCS_ENABLE   1: land when the GCS is silent for 5 s; 3 (this SITL): hold altitude
-                  until the battery failsafe, then land.
+  failsafes       apm25: FS_GCS_ENABLE 1, 5 s after the last heartbeat or override while
+                  overrides are in use; radio failsafe 2 s after the last override (no
+                  receiver, FS_THR_ENABLE 1): LAND. FS_GCS_ENABLE 3 (this SITL): hold
+                  altitude until the battery failsafe, then land. copter4: FS_GCS_ENABLE 0
+                  (no GCS failsafe), FS_GCS_TIMEOUT 5 s; overrides lapse after
+                  RC_OVERRIDE_TIME 3 s to the radio's 1000 µs throttle.
 """
 
 
@@ -155,8 +188,24 @@ def _server_from_args(args: argparse.Namespace) -> SitlServer:
             key = load_signing_key(args.signing_key)
         except SigningKeyError as exc:
             raise CliError(str(exc), 2) from None
+    opts = world.autopilot
+    try:
+        options = AutopilotOptions(
+            realistic_boot=opts.realistic_boot or args.realistic_boot,
+            copter4_version=args.copter4_version or opts.copter4_version,
+        )
+    except ValueError as exc:
+        raise CliError(str(exc), 2) from None
+    if args.copter4_version and profile is not Profile.COPTER4:
+        raise CliError("--copter4-version: needs --profile copter4", 2)
     sim = Simulation(
-        world, profile, args.vehicles, seed=args.seed, noise=not args.no_noise, signing_key=key
+        world,
+        profile,
+        args.vehicles,
+        seed=args.seed,
+        noise=not args.no_noise,
+        signing_key=key,
+        options=options,
     )
     mocap_port = None
     if world.mocap_enabled:
@@ -164,7 +213,8 @@ def _server_from_args(args: argparse.Namespace) -> SitlServer:
             mocap_port = args.mocap_port
         else:
             mocap_port = 0 if args.tcp == 0 else MOCAP_DEFAULT_PORT
-    plan = EndpointPlan(tcp_port=args.tcp, udp=args.udp, serial=args.serial, mocap_port=mocap_port)
+    plan = EndpointPlan(tcp_port=args.tcp, udp=args.udp, serial=args.serial, mocap_port=mocap_port,
+                        truth_port=args.truth_port)
     try:
         return SitlServer(sim, plan, speedup=args.speedup)
     except EndpointError as exc:

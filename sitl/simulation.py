@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sitl.autopilot import Autopilot, ParamStore, Profile, SensorSample
+from sitl.autopilot import Autopilot, AutopilotOptions, ParamStore, Profile, SensorSample
 from sitl.autopilot.params import Key
 from sitl.link.channel import Channel
 from sitl.link.handler import VehicleLink
@@ -53,14 +53,19 @@ class VehicleRuntime:
         rng: np.random.Generator,
         noise: bool,
         signing_key: bytes | None,
+        options: AutopilotOptions | None = None,
     ) -> None:
         self.sysid = sysid
+        options = options or world.autopilot
         self.vehicle = SimVehicle(world, start_pos_n=start_pos_n, rng=rng, noise=noise)
-        self.params = ParamStore(profile)
+        self.params = ParamStore(profile, options)
         self.params.set_key(Key.SYSID_THISMAV, sysid)
-        self.autopilot = Autopilot(profile, self.params, self.vehicle.hover_throttle())
         o = world.origin
         sonar = world.sensors.sonar
+        # the owner configured the rangefinder for the fitted HC-SR04
+        self.params.set_key(Key.RNG_MIN_M, sonar.min_m)
+        self.params.set_key(Key.RNG_MAX_M, sonar.max_m)
+        self.autopilot = Autopilot(profile, self.params, self.vehicle.hover_throttle(), options)
         self.view = VehicleView(
             sysid=sysid,
             profile=profile,
@@ -180,7 +185,9 @@ class Simulation:
         seed: int = 0,
         noise: bool = True,
         signing_key: bytes | None = None,
+        options: AutopilotOptions | None = None,
     ) -> None:
+        """`options` override the world's `[autopilot]` settings when given."""
         if n_vehicles < 1:
             raise ValueError(f"n_vehicles: expected at least 1, got {n_vehicles}")
         self.world = world
@@ -198,7 +205,9 @@ class Simulation:
                 base = starts[-1]
                 start = (base[0], base[1] + float(i - len(starts) + 1), base[2])
             self.vehicles.append(
-                VehicleRuntime(i + 1, world, profile, start, rngs[i], noise, signing_key)
+                VehicleRuntime(
+                    i + 1, world, profile, start, rngs[i], noise, signing_key, options
+                )
             )
 
     @property

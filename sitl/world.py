@@ -15,6 +15,8 @@ on the floor, because heights are what people measure; the loader converts them 
     [origin]     lat_deg = ..., lon_deg = ..., alt_amsl_m = ...
     [sensors.imu] / [sensors.sonar] / ... overrides (see sitl.sensor_params)
     [vehicle]    overrides of sitl.params.VehicleParams
+    [autopilot]  realistic_boot = true      # copter4: the real ≈ 24 s pre-arm delay
+                 copter4_version = "4.6"    # parameter names of a 4.x before 4.7
 
 A bad file raises WorldError with one line: `<file>: <field>: <problem>`.
 """
@@ -29,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sitl.autopilot.profile import AutopilotOptions
 from sitl.params import ParamError, VehicleParams, build_dataclass
 from sitl.sensor_params import SensorParams
 
@@ -119,6 +122,7 @@ class World:
     origin: GeoOrigin = field(default_factory=GeoOrigin)
     sensors: SensorParams = field(default_factory=SensorParams)
     vehicle: VehicleParams = field(default_factory=VehicleParams)
+    autopilot: AutopilotOptions = field(default_factory=AutopilotOptions)
 
     @property
     def floor_z_n(self) -> float:
@@ -157,6 +161,7 @@ _TOP_KEYS = {
     "origin",
     "sensors",
     "vehicle",
+    "autopilot",
 }
 
 
@@ -322,6 +327,7 @@ def world_from_toml(data: Mapping[str, Any]) -> World:
     origin = build_dataclass(GeoOrigin, data.get("origin", {}), "origin")
     sensors = SensorParams.from_toml(data.get("sensors", {}))
     vehicle = build_dataclass(VehicleParams, data.get("vehicle", {}), "vehicle")
+    autopilot = _parse_autopilot(data.get("autopilot", {}))
     return World(
         name=name,
         room_min_n=room[0],
@@ -335,7 +341,20 @@ def world_from_toml(data: Mapping[str, Any]) -> World:
         origin=origin,
         sensors=sensors,
         vehicle=vehicle,
+        autopilot=autopilot,
     )
+
+
+def _parse_autopilot(data: Any) -> AutopilotOptions:
+    data = _table(data, "autopilot", {"realistic_boot", "copter4_version"})
+    realistic = data.get("realistic_boot", False)
+    if not isinstance(realistic, bool):
+        raise ParamError(f"autopilot.realistic_boot: expected true or false, got {realistic!r}")
+    version = data.get("copter4_version", "4.7")
+    try:
+        return AutopilotOptions(realistic_boot=realistic, copter4_version=str(version))
+    except ValueError as exc:
+        raise ParamError(f"autopilot.{exc}") from None
 
 
 def load_world(path: str | Path) -> World:

@@ -1,22 +1,19 @@
 """ArduCopter-like autopilot: attitude and altitude control, modes, failsafes, parameters."""
 
-from sitl.autopilot.autopilot import (
-    Autopilot,
-    AutopilotState,
-    CommandResult,
-    SensorSample,
-    Severity,
-    SystemStatus,
-)
+from sitl.autopilot.arming import CommandResult, MavResult, Severity
+from sitl.autopilot.autopilot import Autopilot
 from sitl.autopilot.params import Key, ParamError, ParamStore, ParamType, param_table
-from sitl.autopilot.profile import FlightMode, Profile
+from sitl.autopilot.profile import AutopilotOptions, FlightMode, Profile
+from sitl.autopilot.state import AutopilotState, SensorSample, SystemStatus
 
 __all__ = [
     "Autopilot",
+    "AutopilotOptions",
     "AutopilotState",
     "CommandResult",
     "FlightMode",
     "Key",
+    "MavResult",
     "ParamError",
     "ParamStore",
     "ParamType",

@@ -1,110 +1,57 @@
 """The autopilot of one simulated vehicle: ArduCopter's STABILIZE, ALT_HOLD and LAND, arming,
-radio with GCS overrides, GCS and battery failsafes. Pure: sensors and time go in, motor
-outputs come out; the MAVLink side lives in `sitl.link`.
+radio with GCS overrides, GCS, radio and battery failsafes, 4.x motor spool-up. Pure: sensors
+and time go in, motor outputs come out; the MAVLink side lives in `sitl.link`. The per-firmware
+rules and the facts behind them are in `arming.py`, `failsafe.py` and `spool.py`.
 """
 
 from __future__ import annotations
 
-import enum
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
+from sitl.autopilot import arming
 from sitl.autopilot.ahrs import GRAVITY_MSS, Ahrs
 from sitl.autopilot.alt_hold import AltitudeController, SurfaceTracker
+from sitl.autopilot.arming import CommandResult, MavResult, Severity
 from sitl.autopilot.attitude import AttitudeController
-from sitl.autopilot.failsafe import BatteryWatch, GcsFailsafeAction, GcsWatch
+from sitl.autopilot.failsafe import BatteryWatch, GcsFailsafeAction, GcsWatch, RadioWatch
 from sitl.autopilot.gains import Gains
 from sitl.autopilot.inertial_nav import InertialNavZ
 from sitl.autopilot.land_detector import LandDetector
 from sitl.autopilot.mixer import MixerOutput, mix_plus
-from sitl.autopilot.params import Key, ParamStore
-from sitl.autopilot.profile import KNOWN_UNSUPPORTED_MODES, FlightMode, Profile
+from sitl.autopilot.params import FS_GCS_TIMEOUT_RANGE_S, Key, ParamStore
+from sitl.autopilot.profile import (
+    KNOWN_UNSUPPORTED_MODES,
+    AutopilotOptions,
+    FlightMode,
+    Profile,
+)
 from sitl.autopilot.radio import Radio
+from sitl.autopilot.spool import Spool
+from sitl.autopilot.state import AutopilotState, SensorSample, SystemStatus
 from sitl.autopilot.throttle_curve import (
     climb_rate_from_stick,
     throttle_apm25,
     throttle_copter4,
 )
 
-FORCE_ARM_MAGIC = 2989.0
-FORCE_DISARM_MAGIC = 21196.0
 STICK_DZ_US = 30  # RCn_DZ for roll/pitch
 YAW_DZ_US = 40
-GYRO_CAL_S = 1.0  # boot-time gyro calibration; arming is refused until it is done
-AUTO_DISARM_S = {Profile.APM25: 15.0, Profile.COPTER4: 10.0}
-SPIN_ARMED = {Profile.APM25: 0.07, Profile.COPTER4: 0.10}  # MOT_SPIN_ARMED 70 / MOT_SPIN_ARM
-BOOT_TEXTS = {
-    Profile.APM25: ("Initialising APM...", "APM:Copter V3.2.1", "Frame: PLUS"),
-    Profile.COPTER4: ("ArduCopter V4.5.7", "Frame: QUAD/PLUS"),
-}
-
-
-class Severity(enum.IntEnum):
-    """MAV_SEVERITY values used in STATUSTEXT."""
-
-    CRITICAL = 2
-    ERROR = 3
-    WARNING = 4
-    NOTICE = 5
-    INFO = 6
-
-
-class SystemStatus(enum.IntEnum):
-    """MAV_STATE values the heartbeat reports."""
-
-    BOOT = 1
-    STANDBY = 3
-    ACTIVE = 4
-    CRITICAL = 5
-
-
-@dataclass(frozen=True)
-class SensorSample:
-    """What the autopilot's sensors delivered this tick (SI, body FRD)."""
-
-    gyro_b: tuple[float, float, float]
-    acc_b: tuple[float, float, float]  # specific force, m/s²
-    baro_alt_m: float | None = None  # new barometric altitude, up positive
-    sonar_m: float | None = None  # sonar distance of a new reading, None if it had no echo
-    sonar_fresh: bool = False  # a sonar reading (with or without echo) arrived this tick
-    battery_v: float = 12.6
-
-
-@dataclass(frozen=True)
-class CommandResult:
-    """Outcome of a GCS command; `text` goes out as STATUSTEXT when set."""
-
-    accepted: bool
-    text: str | None = None
-
-
-@dataclass
-class AutopilotState:
-    """What telemetry reports; refreshed every tick."""
-
-    armed: bool = False
-    mode: FlightMode = FlightMode.STABILIZE
-    roll_rad: float = 0.0
-    pitch_rad: float = 0.0
-    yaw_rad: float = 0.0
-    gyro_rads: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    alt_m: float = 0.0
-    climb_ms: float = 0.0
-    throttle: float = 0.0
-    target_alt_m: float = 0.0
-    motors: MixerOutput = field(default_factory=lambda: MixerOutput((0.0,) * 4, False, False))
-    landed: bool = True
-    gcs_failsafe: bool = False
-    battery_failsafe: bool = False
-    hold_for_gcs: bool = False
+GYRO_CAL_S = 1.0  # boot-time gyro calibration of the attitude estimator
 
 
 class Autopilot:
     """ArduCopter-like flight controller for one vehicle."""
 
-    def __init__(self, profile: Profile, params: ParamStore, hover_throttle: float) -> None:
+    def __init__(
+        self,
+        profile: Profile,
+        params: ParamStore,
+        hover_throttle: float,
+        options: AutopilotOptions | None = None,
+    ) -> None:
         self.profile = profile
+        self.options = options or AutopilotOptions()
         self.params = params
         if profile is Profile.APM25:
             params.set_key(Key.THR_HOVER, round(hover_throttle * 1000.0))
@@ -120,11 +67,15 @@ class Autopilot:
         self.surface = SurfaceTracker()
         self.land = LandDetector(climb_max_ms=0.4 if profile is Profile.APM25 else 1.0)
         self.gcs = GcsWatch()
+        self.radio_watch = RadioWatch()
         self.battery = BatteryWatch()
+        self.spool = Spool()
         self.state = AutopilotState()
-        self.texts: list[tuple[Severity, str]] = [
-            (Severity.INFO, text) for text in BOOT_TEXTS[profile]
-        ]
+        self.texts: list[tuple[int, str]] = []
+        self._timed_texts = arming.boot_texts(profile, self.options)
+        self._arming_until_s: float | None = None  # 3.2.1: arming in progress until then
+        self.arm_completed: CommandResult | None = None  # a pending arm's answer, once
+        self._want_thrust = False
         self._t_s = 0.0
         self._zero_throttle_s = 0.0
         self._last_throttle = 0.0
@@ -141,13 +92,18 @@ class Autopilot:
         self._param_version = self.params.version
         self.gains = Gains.from_params(self.params)
         k = self.params.k
-        self._rc_override_time_s = (
-            k(Key.RC_OVERRIDE_TIME) if self.params.has_key(Key.RC_OVERRIDE_TIME) else 0.0
-        )
+        apm = self.profile is Profile.APM25
+        self._rc_override_time_s = k(Key.RC_OVERRIDE_TIME)
+        lo, hi = FS_GCS_TIMEOUT_RANGE_S
+        timeout = k(Key.FS_GCS_TIMEOUT_S)
+        self._gcs_timeout_s = timeout if apm else min(hi, max(lo, timeout))
+        self._disarm_delay_s = k(Key.DISARM_DELAY_S)
+        self._spool_time_s = k(Key.SPOOL_TIME_S)
+        self._spin_arm = min(0.3, max(0.0, k(Key.SPIN_ARM)))
         self._thr_hover_param = k(Key.THR_HOVER)
         self._thr_min_param = k(Key.THR_MIN)
-        fs_value = int(k(Key.FS_GCS_ENABLE))
-        self._fs_gcs = GcsFailsafeAction(fs_value if 0 <= fs_value <= 3 else 0)
+        self._fs_gcs = GcsFailsafeAction.from_param(k(Key.FS_GCS_ENABLE), apm)
+        self._fs_thr_enabled = k(Key.FS_THR_ENABLE) > 0
         self._fs_batt_enabled = k(Key.FS_BATT_ENABLE) > 0
         self._fs_batt_voltage = k(Key.FS_BATT_VOLTAGE)
         self.attitude.set_gains(self.gains)
@@ -182,14 +138,14 @@ class Autopilot:
 
     # ---- GCS-facing commands --------------------------------------------------------------
     def gcs_seen(self, t_s: float) -> None:
-        """A heartbeat or override arrived from SYSID_MYGCS."""
+        """A heartbeat or override arrived from the GCS system id."""
         self.gcs.seen(t_s)
 
     def rc_override(self, values: Sequence[int], t_s: float) -> None:
-        """Apply an accepted RC_CHANNELS_OVERRIDE."""
+        """Apply an accepted RC_CHANNELS_OVERRIDE (it resets the GCS timer in both firmwares)."""
         self.radio.apply_override(values, t_s)
-        if self.profile is Profile.APM25:
-            self.gcs_seen(t_s)  # 3.2.1 resets its GCS timer on overrides too
+        self.radio_watch.input(t_s)
+        self.gcs_seen(t_s)
 
     def set_mode(self, number: int) -> CommandResult:
         """Change flight mode as ArduCopter's set_mode would."""
@@ -198,10 +154,9 @@ class Autopilot:
         except ValueError:
             name = KNOWN_UNSUPPORTED_MODES.get(number, str(number))
             text = None if self.profile is Profile.APM25 else "Flight mode change failed"
-            return CommandResult(False, text if name else None)
-        if mode is self.state.mode:
-            return CommandResult(True)
-        self._enter_mode(mode)
+            return CommandResult(False, text if name else None, MavResult.FAILED)
+        if mode is not self.state.mode:
+            self._enter_mode(mode)
         return CommandResult(True)
 
     def _enter_mode(self, mode: FlightMode) -> None:
@@ -212,47 +167,73 @@ class Autopilot:
         self.state.mode = mode
         self.state.hold_for_gcs = False
 
+    @property
+    def arming_in_progress(self) -> bool:
+        """3.2.1 is inside init_arm_motors(): main loop blocked, streams paused."""
+        return self._arming_until_s is not None
+
     def arm(self, force: float = 0.0) -> CommandResult:
         """MAV_CMD_COMPONENT_ARM_DISARM param1 = 1."""
+        if self.arming_in_progress:
+            return arming.refused(self.profile, None)
         if self.state.armed:
             return CommandResult(True)
-        forced = self.profile is Profile.COPTER4 and force == FORCE_ARM_MAGIC
-        if not self.calibrated:
-            return CommandResult(False, "PreArm: Gyros not calibrated")
-        if not forced:
-            if self.profile is Profile.COPTER4 and self.state.mode is FlightMode.LAND:
-                return CommandResult(False, "Arm: Mode not armable")
-            if self.state.mode is FlightMode.STABILIZE:
-                too_high = self._throttle_stick() > 0.0
-            else:
-                too_high = self._pilot_climb_cms() > 0.0
-            if too_high:
-                return CommandResult(False, "Arm: Throttle too high")
-        self.state.armed = True
-        self.land.landed = True
-        self.attitude.relax(self.state.yaw_rad)
-        self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
-        self.texts.append((Severity.INFO, "Arming motors"))
+        st = self.state
+        if st.mode is FlightMode.STABILIZE:
+            throttle_up = self._throttle_stick() > 0.0
+        else:
+            throttle_up = self._pilot_climb_cms() > 0.0
+        refusal = arming.arm_check(
+            self.profile, self.options, self._t_s, st.mode, throttle_up, force
+        )
+        if refusal is not None:
+            return refusal
+        if self.profile is Profile.APM25:
+            t = self._t_s
+            self._arming_until_s = t + arming.APM25_ARMING_S
+            texts = arming.apm25_arming_texts()
+            self._timed_texts += [(t + dt, sev, text) for dt, sev, text in texts]
+            return CommandResult(True, pending=True)
+        self._do_arm()
+        self.texts.append((int(Severity.INFO), "Arming motors"))
         return CommandResult(True)
 
+    def _do_arm(self) -> None:
+        self.state.armed = True
+        self.land.landed = True
+        self.spool.arm(self._t_s)
+        self.attitude.relax(self.state.yaw_rad)
+        self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
+
     def disarm(self, force: float = 0.0) -> CommandResult:
-        """MAV_CMD_COMPONENT_ARM_DISARM param1 = 0 (4.x refuses in flight unless forced)."""
+        """MAV_CMD_COMPONENT_ARM_DISARM param1 = 0."""
         if not self.state.armed:
             return CommandResult(True)
-        if self.profile is Profile.COPTER4 and not self.land.landed and force != FORCE_DISARM_MAGIC:
-            return CommandResult(False, "Disarm: vehicle is flying")
+        refusal = arming.disarm_check(self.profile, self.state.mode, self.land.landed, force)
+        if refusal is not None:
+            return refusal
         self._disarm()
         return CommandResult(True)
 
     def _disarm(self) -> None:
         self.state.armed = False
-        self.texts.append((Severity.INFO, "Disarming motors"))
+        self.spool.disarm()
+        self.texts.append(arming.disarm_text(self.profile))
+
+    def version_texts(self) -> list[tuple[int, str]]:
+        """The texts the firmware sends on PARAM_REQUEST_LIST."""
+        return arming.version_texts(self.profile, self.options)
 
     # ---- the main loop ---------------------------------------------------------------------
     def update(self, s: SensorSample, t_s: float, dt_s: float) -> MixerOutput:
         """One main-loop tick: estimate, check failsafes, run the mode, mix."""
         self._t_s = t_s
         self._refresh_gains()
+        self._due_texts(t_s)
+        if self._arming_until_s is not None and t_s + 1e-9 >= self._arming_until_s:
+            self._arming_until_s = None
+            self._do_arm()
+            self.arm_completed = CommandResult(True)
         st = self.state
         g = self.gains
         if not self.calibrated:
@@ -275,31 +256,39 @@ class Autopilot:
         if s.sonar_fresh:
             self.surface.reading(s.sonar_m, tilt_cos, g)
 
-        if self.profile is Profile.COPTER4:
-            self.radio.expire(t_s, self._rc_override_time_s)
+        # 4.x drops overrides after RC_OVERRIDE_TIME (0 = never, 3.2.1's behaviour)
+        self.radio.expire(t_s, self._rc_override_time_s)
         self._failsafes(t_s, s.battery_v)
 
         throttle, t_roll, t_pitch, yaw_rate = self._run_mode(dt_s, acc_up, tilt_cos)
-        if not st.armed:
+        if self.profile is Profile.COPTER4:
+            self.spool.update(t_s, dt_s, self._spool_time_s, st.armed and self._want_thrust)
+            idle, thrust_max = self.spool.idle_ratio, self.spool.thrust_max
+        else:
+            idle = thrust_max = 1.0
+        spin = self._spin_arm
+        if not st.armed or idle < 1.0:
+            # disarmed, or 4.x's arming delay / spool to ground idle: no control authority
             self.attitude.relax(yaw)
-            out = MixerOutput((0.0, 0.0, 0.0, 0.0), False, True)
+            level = spin * idle if st.armed else 0.0
+            out = MixerOutput((level,) * 4, False, True)
+            throttle = 0.0
+        elif throttle <= 0.0 or thrust_max <= 0.0:
+            self.attitude.relax(yaw)
+            out = mix_plus(spin, 0.0, 0.0, 0.0, spin)
             throttle = 0.0
         else:
-            spin = SPIN_ARMED[self.profile]
-            if throttle <= 0.0:
-                self.attitude.relax(yaw)
-                out = mix_plus(spin, 0.0, 0.0, 0.0, spin)
-            else:
-                att = self.attitude.update(
-                    t_roll,
-                    t_pitch,
-                    yaw_rate,
-                    (roll, pitch, yaw),
-                    st.gyro_rads,
-                    dt_s,
-                    saturated=st.motors.limit_high,
-                )
-                out = mix_plus(throttle, att.roll, att.pitch, att.yaw, max(spin, g.thr_min))
+            throttle = min(throttle, thrust_max)
+            att = self.attitude.update(
+                t_roll,
+                t_pitch,
+                yaw_rate,
+                (roll, pitch, yaw),
+                st.gyro_rads,
+                dt_s,
+                saturated=st.motors.limit_high,
+            )
+            out = mix_plus(throttle, att.roll, att.pitch, att.yaw, max(spin, g.thr_min))
         self._last_throttle = throttle
         st.throttle = throttle
         st.motors = out
@@ -308,6 +297,12 @@ class Autopilot:
         st.target_alt_m = self.alt_ctrl.target_alt_cm / 100.0
         self._post_tick(throttle, dt_s)
         return out
+
+    def _due_texts(self, t_s: float) -> None:
+        due = [x for x in self._timed_texts if x[0] <= t_s + 1e-9]
+        if due:
+            self._timed_texts = [x for x in self._timed_texts if x[0] > t_s + 1e-9]
+            self.texts.extend((sev, text) for _, sev, text in due)
 
     def _calibrate(self, s: SensorSample, t_s: float) -> None:
         for i in range(3):
@@ -326,12 +321,12 @@ class Autopilot:
             self._acc_offset = (mean_acc[0], mean_acc[1], mean_acc[2] + GRAVITY_MSS)
             self.ahrs.level_from((0.0, 0.0, -GRAVITY_MSS), 0.0)
             self.calibrated = True
-            self.texts.append((Severity.INFO, "Calibrating barometer"))
 
     def _run_mode(
         self, dt_s: float, acc_up: float, tilt_cos: float
     ) -> tuple[float, float, float, float]:
         st = self.state
+        c4 = self.profile is Profile.COPTER4
         t_roll = self._angle(0)
         t_pitch = self._angle(1)
         yaw_rate = self._yaw_rate()
@@ -339,10 +334,9 @@ class Autopilot:
             t_roll = t_pitch = yaw_rate = 0.0
         if st.mode is FlightMode.STABILIZE:
             stick = self._throttle_stick()
-            if self.profile is Profile.APM25:
-                thr = throttle_apm25(
-                    stick, self._thr_hover_param, self._thr_min_param
-                )
+            self._want_thrust = stick > 0.0
+            if not c4:
+                thr = throttle_apm25(stick, self._thr_hover_param, self._thr_min_param)
             else:
                 thr = throttle_copter4(stick, self.alt_ctrl.hover_throttle)
             if not st.armed:
@@ -350,13 +344,17 @@ class Autopilot:
             return thr, t_roll, t_pitch, yaw_rate
         if st.mode is FlightMode.ALT_HOLD:
             climb = 0.0 if st.hold_for_gcs else self._pilot_climb_cms()
-            if not st.armed or (self.land.landed and climb <= 0.0):
+            self._want_thrust = climb > 0.0 or not self.land.landed
+            # 4.x takes off only once the motors have spooled up (takeoff.triggered)
+            waiting = c4 and self.land.landed and not self.spool.unlimited
+            if not st.armed or (self.land.landed and climb <= 0.0) or waiting:
                 self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
                 return 0.0, t_roll, t_pitch, yaw_rate
             if self.land.landed and self._last_throttle <= 0.0:
                 self.alt_ctrl.init_takeoff(self.inav.alt_m * 100.0)
         else:  # LAND
             climb = -self.gains.land_speed_cms
+            self._want_thrust = not self.land.landed
             if not st.armed or self.land.landed:
                 self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
                 return 0.0, t_roll, t_pitch, yaw_rate
@@ -390,55 +388,73 @@ class Autopilot:
         )
         st.landed = self.land.landed
         stick_zero = self._throttle_stick() <= 0.0
-        # 3.2.1 (LAND_REQUIRE_MIN_THROTTLE_TO_DISARM) waits for the stick or a failsafe
-        disarm_ok = self.profile is Profile.COPTER4 or stick_zero or st.gcs_failsafe
+        # 3.2.1 (LAND_REQUIRE_MIN_THROTTLE_TO_DISARM) waits for the stick or the radio failsafe
+        disarm_ok = self.profile is Profile.COPTER4 or stick_zero or st.radio_failsafe
         if st.mode is FlightMode.LAND and self.land.landed and disarm_ok:
             self._disarm()
             return
         if touched:
             self._zero_throttle_s = 0.0
-        if self.land.landed and stick_zero and st.mode is FlightMode.STABILIZE:
+        # auto-disarm: landed with the stick down for DISARM_DELAY (4.x, 0 = off) or 15 s (3.2.1)
+        if self.land.landed and stick_zero and self._disarm_delay_s > 0.0:
             self._zero_throttle_s += dt_s
-            if self._zero_throttle_s >= AUTO_DISARM_S[self.profile]:
+            if self._zero_throttle_s >= self._disarm_delay_s:
                 self._disarm()
         else:
             self._zero_throttle_s = 0.0
 
+    def _failsafe_action(self, stick_zero: bool) -> None:
+        """What both firmwares do on a radio or GCS failsafe without GPS (RTL cannot, lands)."""
+        st = self.state
+        if not st.armed:
+            return
+        if self.land.landed or (st.mode is FlightMode.STABILIZE and stick_zero):
+            self._disarm()
+        elif st.mode is not FlightMode.LAND:
+            self._enter_mode(FlightMode.LAND)
+
     def _failsafes(self, t_s: float, battery_v: float) -> None:
         st = self.state
+        apm = self.profile is Profile.APM25
+        # the throttle as the failsafe code sees it, before the overrides are cleared
+        stick_zero = self._throttle_stick() <= 0.0
+        if apm and self._fs_thr_enabled:
+            change = self.radio_watch.check(t_s, st.armed)
+            if change is True:
+                st.radio_failsafe = True
+                self._failsafe_action(stick_zero)
+            elif change is False:
+                st.radio_failsafe = False
+        elif st.radio_failsafe:
+            st.radio_failsafe = self.radio_watch.active = False
         action = self._fs_gcs
-        change = self.gcs.check(
-            t_s,
-            requires_override=self.profile is Profile.APM25,
-            override_active=self.radio.overridden,
-        )
-        if action is GcsFailsafeAction.DISABLED and change is True:
-            self.gcs.active = False
-            change = None
+        change = None
+        if (st.armed and action is not GcsFailsafeAction.DISABLED) or self.gcs.active:
+            change = self.gcs.check(
+                t_s,
+                requires_override=apm,
+                override_active=self.radio.overridden,
+                timeout_s=self._gcs_timeout_s,
+            )
         if change is True:
             st.gcs_failsafe = True
             self.radio.clear_overrides()
-            self.texts.append((Severity.CRITICAL, "GCS Failsafe"))
-            if st.armed:
-                if self.land.landed:
-                    self._disarm()
-                elif action is GcsFailsafeAction.HOLD_THEN_LAND:
-                    if st.mode is not FlightMode.LAND:
-                        self._enter_mode(FlightMode.ALT_HOLD)
-                        st.hold_for_gcs = True
-                elif not (
-                    action is GcsFailsafeAction.CONTINUE
-                    and self.profile is Profile.APM25
-                    and st.mode is FlightMode.LAND
-                ):
-                    self._enter_mode(FlightMode.LAND)
+            if not apm:
+                self.texts.append((int(Severity.WARNING), "GCS Failsafe"))
+            if action is GcsFailsafeAction.HOLD_THEN_LAND and apm and not self.land.landed:
+                if st.mode is not FlightMode.LAND:
+                    self._enter_mode(FlightMode.ALT_HOLD)
+                    st.hold_for_gcs = True
+            elif not (action is GcsFailsafeAction.CONTINUE and apm and st.mode is FlightMode.LAND):
+                self._failsafe_action(stick_zero)
         elif change is False:
             st.gcs_failsafe = False
             st.hold_for_gcs = False
-            self.texts.append((Severity.INFO, "GCS Failsafe Cleared"))
+            if not apm:
+                self.texts.append((int(Severity.INFO), "GCS Failsafe Cleared"))
         if self._fs_batt_enabled and self.battery.check(t_s, battery_v, self._fs_batt_voltage):
             st.battery_failsafe = True
-            self.texts.append((Severity.CRITICAL, f"Battery failsafe: {battery_v:.2f}V"))
+            self.texts.append((int(Severity.CRITICAL), f"Battery failsafe: {battery_v:.2f}V"))
             if st.armed:
                 if self.land.landed:
                     self._disarm()
@@ -446,11 +462,19 @@ class Autopilot:
                     self._enter_mode(FlightMode.LAND)
 
     @property
+    def booting(self) -> bool:
+        """4.x's first seconds: HEARTBEAT base_mode 89, system_status BOOT (3.2.1 has neither)."""
+        return self.profile is Profile.COPTER4 and self._t_s < arming.COPTER4_BOOT_S
+
+    @property
     def system_status(self) -> SystemStatus:
-        """BOOT while calibrating, STANDBY disarmed, ACTIVE armed, CRITICAL in a failsafe."""
+        """Follows the land detector as both firmwares do: STANDBY landed, ACTIVE flying,
+        CRITICAL in a failsafe; 4.x BOOT at first, 3.2.1 ACTIVE until its land detector runs."""
         st = self.state
-        if not self.calibrated:
+        if self.booting:
             return SystemStatus.BOOT
-        if st.gcs_failsafe or st.battery_failsafe:
+        if st.gcs_failsafe or st.battery_failsafe or st.radio_failsafe:
             return SystemStatus.CRITICAL
-        return SystemStatus.ACTIVE if st.armed else SystemStatus.STANDBY
+        if self.profile is Profile.APM25 and self._t_s < arming.APM25_FIRST_LANDED_S:
+            return SystemStatus.ACTIVE
+        return SystemStatus.STANDBY if st.landed else SystemStatus.ACTIVE

@@ -1,26 +1,50 @@
-"""GCS and battery failsafe timers (pure: time passed in)."""
+"""GCS, radio and battery failsafe timers (pure: time passed in).
+
+- GCS failsafe: 3.2.1 fires 5 s (fixed FS_GCS_TIMEOUT_MS) after the last GCS heartbeat or RC
+  override (both reset the timer), only while overrides are in use; 4.x fires FS_GCS_TIMEOUT
+  after the last heartbeat or override from MAV_GCS_SYSID once the GCS has been seen. Both only
+  while armed, and only when FS_GCS_ENABLE is not 0 (4.x's default is 0: no GCS failsafe).
+- Radio failsafe (3.2.1, FS_THR_ENABLE): with no RC receiver the only radio input is the GCS's
+  overrides, so `read_radio()` sees no new frame 2 s (FAILSAFE_RADIO_TIMEOUT_MS) after the last
+  override and sets failsafe.radio. A vehicle without overrides ever has no input to lose.
+"""
 
 from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
 
-GCS_TIMEOUT_S = 5.0  # FS_GCS_TIMEOUT of both firmwares
+GCS_TIMEOUT_S = 5.0  # 3.2.1's fixed FS_GCS_TIMEOUT_MS; 4.x's FS_GCS_TIMEOUT default
+RADIO_TIMEOUT_S = 2.0  # 3.2.1 FAILSAFE_RADIO_TIMEOUT_MS
 BATT_LOW_TIMER_S = 10.0  # voltage must stay low this long (BATT_LOW_TIMER)
 
 
 class GcsFailsafeAction(enum.IntEnum):
-    """FS_GCS_ENABLE values."""
+    """FS_GCS_ENABLE values (without GPS every RTL-like action becomes LAND)."""
 
     DISABLED = 0
-    LAND = 1  # RTL in the firmware; without GPS it lands
-    CONTINUE = 2  # 3.2.1: continue in AUTO (lands in other modes); 4.x: same as LAND here
-    HOLD_THEN_LAND = 3  # this SITL's option: hold altitude, land on low battery
+    LAND = 1  # RTL in both firmwares; without GPS it lands
+    CONTINUE = 2  # continue a mission in AUTO, else RTL (lands)
+    HOLD_THEN_LAND = 3  # on 3.2.1 this SITL's own option; on 4.x SmartRTL or RTL (lands)
+    SMART_RTL_OR_LAND = 4  # 4.x only
+    LAND_NOW = 5  # 4.x only: LAND
+
+    @classmethod
+    def from_param(cls, value: float, apm25: bool) -> GcsFailsafeAction:
+        """The action a parameter value asks for; unknown values act as LAND (not disabled)."""
+        v = int(value)
+        if v == 0:
+            return cls.DISABLED
+        if apm25:
+            return cls(v) if v in (1, 2, 3) else cls.LAND
+        if 1 <= v <= 5:
+            return cls(v) if v != 3 else cls.LAND  # 4.x's 3 is SmartRTL→RTL: lands here
+        return cls.LAND
 
 
 @dataclass
 class GcsWatch:
-    """When the GCS was last heard (heartbeat or override from SYSID_MYGCS)."""
+    """When the GCS was last heard (heartbeat or override from the GCS system id)."""
 
     last_seen_s: float | None = None
     active: bool = False
@@ -29,7 +53,13 @@ class GcsWatch:
         """Record GCS traffic."""
         self.last_seen_s = t_s
 
-    def check(self, t_s: float, requires_override: bool, override_active: bool) -> bool | None:
+    def check(
+        self,
+        t_s: float,
+        requires_override: bool,
+        override_active: bool,
+        timeout_s: float = GCS_TIMEOUT_S,
+    ) -> bool | None:
         """Return True on the tick the failsafe starts, False on the tick it ends, else None.
 
         3.2.1 only arms this failsafe once the GCS has been overriding the sticks
@@ -37,13 +67,38 @@ class GcsWatch:
         """
         if self.last_seen_s is None:
             return None
-        silent = t_s - self.last_seen_s > GCS_TIMEOUT_S
+        silent = t_s - self.last_seen_s > timeout_s
         if silent and not self.active:
             if requires_override and not override_active:
                 return None
             self.active = True
             return True
         if not silent and self.active:
+            self.active = False
+            return False
+        return None
+
+
+@dataclass
+class RadioWatch:
+    """3.2.1's radio failsafe with no receiver: new radio input comes only from overrides."""
+
+    last_input_s: float | None = None
+    active: bool = False
+
+    def input(self, t_s: float) -> None:
+        """An override arrived (a new radio frame as far as `read_radio()` is concerned)."""
+        self.last_input_s = t_s
+
+    def check(self, t_s: float, armed: bool) -> bool | None:
+        """True on the tick the failsafe starts, False when input returns, else None."""
+        if self.last_input_s is None:
+            return None
+        late = t_s - self.last_input_s >= RADIO_TIMEOUT_S
+        if late and not self.active and armed:
+            self.active = True
+            return True
+        if not late and self.active:
             self.active = False
             return False
         return None

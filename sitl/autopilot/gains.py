@@ -78,8 +78,8 @@ class Gains:
             thr_dz=k(Key.THR_DZ),
             pilot_velz_max_cms=k(Key.PILOT_VELZ_MAX),
             inav_tc_z_s=max(0.1, k(Key.INAV_TC_Z)),
-            rng_min_m=k(Key.RNG_MIN_CM) / 100.0,
-            rng_max_m=k(Key.RNG_MAX_CM) / 100.0,
+            rng_min_m=k(Key.RNG_MIN_M),
+            rng_max_m=k(Key.RNG_MAX_M),
             rng_gain=k(Key.RNG_GAIN),
             land_speed_cms=k(Key.LAND_SPEED),
         )

@@ -1,21 +1,40 @@
-"""Parameter tables (ArduCopter names per profile) and the parameter store.
+"""Parameter tables (the real firmware's lists) and the parameter store.
 
-Each profile has its own firmware's names: Copter 3.2.1 calls the altitude cascade THR_ALT_P /
-THR_RATE_P / THR_ACCEL_*, Copter 4.x PSC_POSZ_P / PSC_VELZ_P / PSC_ACCZ_*; the attitude gains are
-STB_* / RATE_* on 3.2.1 and ATC_ANG_* / ATC_RAT_* on 4.x (in different units, converted in
-`gains.py`). Defaults are the firmware's defaults except where noted in `PARAM_NOTES`.
-INAV_TC_Z is kept on copter4 too (4.x uses an EKF instead; this SITL keeps the 3.2.1 filter).
-FS_GCS_ENABLE value 3 is this SITL's own option: hold altitude (ALT_HOLD, climb rate zero) while
-the GCS is silent and land when the battery failsafe trips.
+Each profile serves its firmware's complete parameter list, names, wire types, order and
+defaults, read from the real firmware built as SITL (`sitl/autopilot/firmware/*.json`, taken from
+the PARAM_VALUE frames of the fixture tlogs): 412 parameters for ArduCopter 3.2.1, 1364 for
+ArduCopter 4.7-dev. A 4.x older than 4.7 (`AutopilotOptions.copter4_version = "4.6"`) serves
+the same list under its older names: SYSID_THISMAV / SYSID_MYGCS for MAV_SYSID / MAV_GCS_SYSID
+and SR0_..SR2_ for MAV1_..MAV3_ (4.7's renames).
+
+The SITL reads the parameters it implements through `Key` (a profile-independent meaning mapped
+to the firmware's name and unit). A meaning the firmware has no parameter for (3.2.1's fixed
+5 s GCS timeout and 15 s auto-disarm, 4.x's missing INAV_TC_Z) reads a fixed value.
+
+Owner-tuned values set at start, as an owner would have: THR_MID / MOT_THST_HOVER from the
+airframe's hover throttle, and the rangefinder limits from the world's sonar (an HC-SR04,
+0.02–4 m, where the SITL builds ship RNGFND_MIN_CM 20 / RNGFND1_MIN 0.2 m). Everything else is
+the firmware's default, including the ones that make a station's pre-flight checks matter:
+3.2.1 FS_GCS_ENABLE 1, FS_THR_ENABLE 1, FS_BATT_ENABLE 0; 4.7 FS_GCS_ENABLE 0, FS_GCS_TIMEOUT 5,
+BATT_FS_LOW_ACT 0, RC_OVERRIDE_TIME 3, DISARM_DELAY 10, MOT_SPOOL_TIME 0.5. FS_GCS_ENABLE 3 on
+3.2.1 (not a 3.2.1 value) is this SITL's own option: hold altitude while the GCS is silent and
+land when the battery failsafe trips.
 """
 
 from __future__ import annotations
 
 import enum
+import json
 import math
+import re
 from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
 
-from sitl.autopilot.profile import Profile
+from sitl.autopilot.profile import AutopilotOptions, Profile
+
+FIRMWARE_DIR = Path(__file__).with_name("firmware")
+FIRMWARE_FILES = {Profile.APM25: "arducopter-3.2.1.json", Profile.COPTER4: "arducopter-4.7.json"}
 
 
 class ParamType(enum.IntEnum):
@@ -58,17 +77,22 @@ class Key(enum.Enum):
     PILOT_VELZ_MAX = enum.auto()
     ANGLE_MAX = enum.auto()
     FS_GCS_ENABLE = enum.auto()
+    FS_GCS_TIMEOUT_S = enum.auto()
+    FS_THR_ENABLE = enum.auto()
     FS_BATT_ENABLE = enum.auto()
     FS_BATT_VOLTAGE = enum.auto()
     RC_OVERRIDE_TIME = enum.auto()
     SYSID_THISMAV = enum.auto()
     SYSID_MYGCS = enum.auto()
     INAV_TC_Z = enum.auto()
-    RNG_MIN_CM = enum.auto()
-    RNG_MAX_CM = enum.auto()
+    RNG_MIN_M = enum.auto()
+    RNG_MAX_M = enum.auto()
     RNG_GAIN = enum.auto()
     LAND_SPEED = enum.auto()
     BATT_CAPACITY = enum.auto()
+    DISARM_DELAY_S = enum.auto()
+    SPOOL_TIME_S = enum.auto()
+    SPIN_ARM = enum.auto()
 
 
 @dataclass(frozen=True)
@@ -78,15 +102,101 @@ class ParamSpec:
     name: str
     default: float
     ptype: ParamType = ParamType.REAL32
-    key: Key | None = None
 
 
-_F = ParamType.REAL32
-_I8 = ParamType.INT8
-_I16 = ParamType.INT16
-_I32 = ParamType.INT32
+# Key -> (firmware name, scale to the unit the SITL uses). Units stay the firmware's where the
+# control code converts them itself (gains.py), so the scale is 1 there.
+_APM25_KEYS: dict[Key, tuple[str, float]] = {
+    Key.STB_RLL_P: ("STB_RLL_P", 1.0),
+    Key.STB_PIT_P: ("STB_PIT_P", 1.0),
+    Key.STB_YAW_P: ("STB_YAW_P", 1.0),
+    **{
+        getattr(Key, f"RATE_{ax}_{g}"): (f"RATE_{ax}_{g}", 1.0)
+        for ax in ("RLL", "PIT", "YAW")
+        for g in ("P", "I", "D", "IMAX")
+    },
+    Key.PILOT_YAW: ("ACRO_YAW_P", 1.0),
+    Key.POS_Z_P: ("THR_ALT_P", 1.0),
+    Key.VEL_Z_P: ("THR_RATE_P", 1.0),
+    Key.ACC_Z_P: ("THR_ACCEL_P", 1.0),
+    Key.ACC_Z_I: ("THR_ACCEL_I", 1.0),
+    Key.ACC_Z_D: ("THR_ACCEL_D", 1.0),
+    Key.ACC_Z_IMAX: ("THR_ACCEL_IMAX", 1.0),
+    Key.THR_HOVER: ("THR_MID", 1.0),
+    Key.THR_MIN: ("THR_MIN", 1.0),
+    Key.THR_DZ: ("THR_DZ", 1.0),
+    Key.PILOT_VELZ_MAX: ("PILOT_VELZ_MAX", 1.0),
+    Key.ANGLE_MAX: ("ANGLE_MAX", 1.0),
+    Key.FS_GCS_ENABLE: ("FS_GCS_ENABLE", 1.0),
+    Key.FS_THR_ENABLE: ("FS_THR_ENABLE", 1.0),
+    Key.FS_BATT_ENABLE: ("FS_BATT_ENABLE", 1.0),
+    Key.FS_BATT_VOLTAGE: ("FS_BATT_VOLTAGE", 1.0),
+    Key.SYSID_THISMAV: ("SYSID_THISMAV", 1.0),
+    Key.SYSID_MYGCS: ("SYSID_MYGCS", 1.0),
+    Key.INAV_TC_Z: ("INAV_TC_Z", 1.0),
+    Key.RNG_MIN_M: ("RNGFND_MIN_CM", 0.01),
+    Key.RNG_MAX_M: ("RNGFND_MAX_CM", 0.01),
+    Key.RNG_GAIN: ("RNGFND_GAIN", 1.0),
+    Key.LAND_SPEED: ("LAND_SPEED", 1.0),
+    Key.BATT_CAPACITY: ("BATT_CAPACITY", 1.0),
+    Key.SPIN_ARM: ("MOT_SPIN_ARMED", 0.001),
+}
 
-STREAM_GROUPS: tuple[str, ...] = (
+_COPTER4_KEYS: dict[Key, tuple[str, float]] = {
+    Key.STB_RLL_P: ("ATC_ANG_RLL_P", 1.0),
+    Key.STB_PIT_P: ("ATC_ANG_PIT_P", 1.0),
+    Key.STB_YAW_P: ("ATC_ANG_YAW_P", 1.0),
+    **{
+        getattr(Key, f"RATE_{ax}_{g}"): (f"ATC_RAT_{ax}_{g}", 1.0)
+        for ax in ("RLL", "PIT", "YAW")
+        for g in ("P", "I", "D", "IMAX")
+    },
+    Key.PILOT_YAW: ("PILOT_Y_RATE", 1.0),
+    Key.POS_Z_P: ("PSC_POSZ_P", 1.0),
+    Key.VEL_Z_P: ("PSC_VELZ_P", 1.0),
+    Key.ACC_Z_P: ("PSC_ACCZ_P", 1.0),
+    Key.ACC_Z_I: ("PSC_ACCZ_I", 1.0),
+    Key.ACC_Z_D: ("PSC_ACCZ_D", 1.0),
+    Key.ACC_Z_IMAX: ("PSC_ACCZ_IMAX", 1.0),
+    Key.THR_HOVER: ("MOT_THST_HOVER", 1.0),
+    Key.THR_MIN: ("MOT_SPIN_MIN", 1.0),
+    Key.THR_DZ: ("THR_DZ", 1.0),
+    Key.PILOT_VELZ_MAX: ("PILOT_SPEED_UP", 1.0),
+    Key.ANGLE_MAX: ("ANGLE_MAX", 1.0),
+    Key.FS_GCS_ENABLE: ("FS_GCS_ENABLE", 1.0),
+    Key.FS_GCS_TIMEOUT_S: ("FS_GCS_TIMEOUT", 1.0),
+    Key.FS_THR_ENABLE: ("FS_THR_ENABLE", 1.0),
+    Key.FS_BATT_ENABLE: ("BATT_FS_LOW_ACT", 1.0),
+    Key.FS_BATT_VOLTAGE: ("BATT_LOW_VOLT", 1.0),
+    Key.RC_OVERRIDE_TIME: ("RC_OVERRIDE_TIME", 1.0),
+    Key.SYSID_THISMAV: ("MAV_SYSID", 1.0),
+    Key.SYSID_MYGCS: ("MAV_GCS_SYSID", 1.0),
+    Key.RNG_MIN_M: ("RNGFND1_MIN", 1.0),
+    Key.RNG_MAX_M: ("RNGFND1_MAX", 1.0),
+    Key.LAND_SPEED: ("LAND_SPEED", 1.0),
+    Key.BATT_CAPACITY: ("BATT_CAPACITY", 1.0),
+    Key.DISARM_DELAY_S: ("DISARM_DELAY", 1.0),
+    Key.SPOOL_TIME_S: ("MOT_SPOOL_TIME", 1.0),
+    Key.SPIN_ARM: ("MOT_SPIN_ARM", 1.0),
+}
+
+# What a meaning reads when the firmware has no parameter for it.
+FIXED_VALUES: dict[Profile, dict[Key, float]] = {
+    # 3.2.1: FS_GCS_TIMEOUT_MS 5000 and AUTO_DISARMING_DELAY 15 are compile-time constants;
+    # overrides never time out; no spool logic (the motors spin at MOT_SPIN_ARMED at once).
+    Profile.APM25: {
+        Key.FS_GCS_TIMEOUT_S: 5.0,
+        Key.DISARM_DELAY_S: 15.0,
+        Key.RC_OVERRIDE_TIME: 0.0,
+        Key.SPOOL_TIME_S: 0.0,
+    },
+    # 4.x estimates height with its EKF; this SITL keeps the 3.2.1 filter and surface tracking
+    # gain on copter4 too.
+    Profile.COPTER4: {Key.INAV_TC_Z: 5.0, Key.RNG_GAIN: 0.8},
+}
+
+FS_GCS_TIMEOUT_RANGE_S = (2.0, 120.0)  # 4.x FS_GCS_TIMEOUT's documented range
+STREAM_SUFFIXES = (
     "RAW_SENS",
     "EXT_STAT",
     "RC_CHAN",
@@ -96,141 +206,40 @@ STREAM_GROUPS: tuple[str, ...] = (
     "EXTRA2",
     "EXTRA3",
     "PARAMS",
+    "ADSB",
 )
+_MAVN = re.compile(r"^MAV(\d)_(" + "|".join(STREAM_SUFFIXES) + r"|OPTIONS)$")
+_PRE_47_RENAMES = {"MAV_SYSID": "SYSID_THISMAV", "MAV_GCS_SYSID": "SYSID_MYGCS"}
 
 
-def _stream_specs(n_ports: int) -> list[ParamSpec]:
-    """SRn_* stream-rate parameters, 0 Hz by default as on the real firmware."""
-    return [
-        ParamSpec(f"SR{port}_{group}", 0.0, _I16)
-        for port in range(n_ports)
-        for group in STREAM_GROUPS
-    ]
+@cache
+def _firmware_table(profile: Profile) -> tuple[ParamSpec, ...]:
+    doc = json.loads((FIRMWARE_DIR / FIRMWARE_FILES[profile]).read_text(encoding="utf-8"))
+    return tuple(ParamSpec(name, float(value), ParamType(t)) for name, t, value in doc["params"])
 
 
-_APM25: list[ParamSpec] = [
-    ParamSpec("SYSID_SW_MREV", 120.0, _I16),
-    ParamSpec("SYSID_SW_TYPE", 10.0, _I8),
-    ParamSpec("SYSID_THISMAV", 1.0, _I16, Key.SYSID_THISMAV),
-    ParamSpec("SYSID_MYGCS", 255.0, _I16, Key.SYSID_MYGCS),
-    ParamSpec("FRAME", 0.0, _I8),  # 0 = PLUS
-    ParamSpec("ANGLE_MAX", 4500.0, _I16, Key.ANGLE_MAX),
-    ParamSpec("STB_RLL_P", 4.5, _F, Key.STB_RLL_P),
-    ParamSpec("STB_PIT_P", 4.5, _F, Key.STB_PIT_P),
-    ParamSpec("STB_YAW_P", 4.5, _F, Key.STB_YAW_P),
-    ParamSpec("RATE_RLL_P", 0.15, _F, Key.RATE_RLL_P),
-    ParamSpec("RATE_RLL_I", 0.1, _F, Key.RATE_RLL_I),
-    ParamSpec("RATE_RLL_D", 0.004, _F, Key.RATE_RLL_D),
-    ParamSpec("RATE_RLL_IMAX", 1000.0, _F, Key.RATE_RLL_IMAX),
-    ParamSpec("RATE_PIT_P", 0.15, _F, Key.RATE_PIT_P),
-    ParamSpec("RATE_PIT_I", 0.1, _F, Key.RATE_PIT_I),
-    ParamSpec("RATE_PIT_D", 0.004, _F, Key.RATE_PIT_D),
-    ParamSpec("RATE_PIT_IMAX", 1000.0, _F, Key.RATE_PIT_IMAX),
-    ParamSpec("RATE_YAW_P", 0.2, _F, Key.RATE_YAW_P),
-    ParamSpec("RATE_YAW_I", 0.02, _F, Key.RATE_YAW_I),
-    ParamSpec("RATE_YAW_D", 0.0, _F, Key.RATE_YAW_D),
-    ParamSpec("RATE_YAW_IMAX", 1000.0, _F, Key.RATE_YAW_IMAX),
-    ParamSpec("ACRO_YAW_P", 4.5, _F, Key.PILOT_YAW),
-    ParamSpec("THR_ALT_P", 1.0, _F, Key.POS_Z_P),
-    ParamSpec("THR_RATE_P", 5.0, _F, Key.VEL_Z_P),
-    ParamSpec("THR_ACCEL_P", 0.5, _F, Key.ACC_Z_P),
-    ParamSpec("THR_ACCEL_I", 1.0, _F, Key.ACC_Z_I),
-    ParamSpec("THR_ACCEL_D", 0.0, _F, Key.ACC_Z_D),
-    ParamSpec("THR_ACCEL_IMAX", 800.0, _F, Key.ACC_Z_IMAX),
-    ParamSpec("THR_MID", 500.0, _I16, Key.THR_HOVER),
-    ParamSpec("THR_MIN", 130.0, _I16, Key.THR_MIN),
-    ParamSpec("THR_MAX", 1000.0, _I16),
-    ParamSpec("THR_DZ", 100.0, _I16, Key.THR_DZ),
-    ParamSpec("PILOT_VELZ_MAX", 250.0, _I16, Key.PILOT_VELZ_MAX),
-    ParamSpec("FS_GCS_ENABLE", 1.0, _I8, Key.FS_GCS_ENABLE),
-    ParamSpec("FS_BATT_ENABLE", 1.0, _I8, Key.FS_BATT_ENABLE),
-    ParamSpec("FS_BATT_VOLTAGE", 10.5, _F, Key.FS_BATT_VOLTAGE),
-    ParamSpec("FS_BATT_MAH", 0.0, _F),
-    ParamSpec("INAV_TC_Z", 5.0, _F, Key.INAV_TC_Z),
-    ParamSpec("RNGFND_TYPE", 1.0, _I8),
-    ParamSpec("RNGFND_MIN_CM", 2.0, _I16, Key.RNG_MIN_CM),
-    ParamSpec("RNGFND_MAX_CM", 400.0, _I16, Key.RNG_MAX_CM),
-    ParamSpec("RNGFND_GAIN", 0.8, _F, Key.RNG_GAIN),
-    ParamSpec("LAND_SPEED", 50.0, _F, Key.LAND_SPEED),
-    ParamSpec("BATT_MONITOR", 4.0, _I8),
-    ParamSpec("BATT_CAPACITY", 3300.0, _I32, Key.BATT_CAPACITY),
-    ParamSpec("ARMING_CHECK", 1.0, _I8),
-    *[
-        ParamSpec(f"RC{ch}_{f}", v, _I16)
-        for ch in range(1, 9)
-        for f, v in (("MIN", 1000.0), ("MAX", 2000.0), ("TRIM", 1000.0 if ch == 3 else 1500.0))
-    ],
-]
-
-_COPTER4: list[ParamSpec] = [
-    ParamSpec("FORMAT_VERSION", 120.0, _I16),
-    ParamSpec("SYSID_THISMAV", 1.0, _I16, Key.SYSID_THISMAV),
-    ParamSpec("SYSID_MYGCS", 255.0, _I16, Key.SYSID_MYGCS),
-    ParamSpec("FRAME_CLASS", 1.0, _I8),  # QUAD
-    ParamSpec("FRAME_TYPE", 0.0, _I8),  # PLUS
-    ParamSpec("ANGLE_MAX", 4500.0, _I16, Key.ANGLE_MAX),
-    ParamSpec("ATC_ANG_RLL_P", 4.5, _F, Key.STB_RLL_P),
-    ParamSpec("ATC_ANG_PIT_P", 4.5, _F, Key.STB_PIT_P),
-    ParamSpec("ATC_ANG_YAW_P", 4.5, _F, Key.STB_YAW_P),
-    ParamSpec("ATC_RAT_RLL_P", 0.135, _F, Key.RATE_RLL_P),
-    ParamSpec("ATC_RAT_RLL_I", 0.135, _F, Key.RATE_RLL_I),
-    ParamSpec("ATC_RAT_RLL_D", 0.0036, _F, Key.RATE_RLL_D),
-    ParamSpec("ATC_RAT_RLL_IMAX", 0.5, _F, Key.RATE_RLL_IMAX),
-    ParamSpec("ATC_RAT_PIT_P", 0.135, _F, Key.RATE_PIT_P),
-    ParamSpec("ATC_RAT_PIT_I", 0.135, _F, Key.RATE_PIT_I),
-    ParamSpec("ATC_RAT_PIT_D", 0.0036, _F, Key.RATE_PIT_D),
-    ParamSpec("ATC_RAT_PIT_IMAX", 0.5, _F, Key.RATE_PIT_IMAX),
-    ParamSpec("ATC_RAT_YAW_P", 0.18, _F, Key.RATE_YAW_P),
-    ParamSpec("ATC_RAT_YAW_I", 0.018, _F, Key.RATE_YAW_I),
-    ParamSpec("ATC_RAT_YAW_D", 0.0, _F, Key.RATE_YAW_D),
-    ParamSpec("ATC_RAT_YAW_IMAX", 0.5, _F, Key.RATE_YAW_IMAX),
-    ParamSpec("PILOT_Y_RATE", 202.5, _F, Key.PILOT_YAW),
-    ParamSpec("PSC_POSZ_P", 1.0, _F, Key.POS_Z_P),
-    ParamSpec("PSC_VELZ_P", 5.0, _F, Key.VEL_Z_P),
-    ParamSpec("PSC_ACCZ_P", 0.5, _F, Key.ACC_Z_P),
-    ParamSpec("PSC_ACCZ_I", 1.0, _F, Key.ACC_Z_I),
-    ParamSpec("PSC_ACCZ_D", 0.0, _F, Key.ACC_Z_D),
-    ParamSpec("PSC_ACCZ_IMAX", 800.0, _F, Key.ACC_Z_IMAX),
-    ParamSpec("MOT_THST_HOVER", 0.35, _F, Key.THR_HOVER),
-    ParamSpec("MOT_HOVER_LEARN", 2.0, _I8),
-    ParamSpec("MOT_SPIN_ARM", 0.1, _F),
-    ParamSpec("MOT_SPIN_MIN", 0.15, _F, Key.THR_MIN),
-    ParamSpec("THR_DZ", 100.0, _I16, Key.THR_DZ),
-    ParamSpec("PILOT_SPEED_UP", 250.0, _I16, Key.PILOT_VELZ_MAX),
-    ParamSpec("FS_GCS_ENABLE", 1.0, _I8, Key.FS_GCS_ENABLE),
-    ParamSpec("FS_GCS_TIMEOUT", 5.0, _F),
-    ParamSpec("BATT_FS_LOW_ACT", 1.0, _I8, Key.FS_BATT_ENABLE),
-    ParamSpec("BATT_LOW_VOLT", 10.5, _F, Key.FS_BATT_VOLTAGE),
-    ParamSpec("BATT_CAPACITY", 3300.0, _I32, Key.BATT_CAPACITY),
-    ParamSpec("RC_OVERRIDE_TIME", 3.0, _F, Key.RC_OVERRIDE_TIME),
-    ParamSpec("INAV_TC_Z", 5.0, _F, Key.INAV_TC_Z),
-    ParamSpec("RNGFND1_TYPE", 1.0, _I8),
-    ParamSpec("RNGFND1_ORIENT", 25.0, _I8),
-    ParamSpec("RNGFND1_MIN_CM", 2.0, _I16, Key.RNG_MIN_CM),
-    ParamSpec("RNGFND1_MAX_CM", 400.0, _I16, Key.RNG_MAX_CM),
-    ParamSpec("RNGFND_GAIN", 0.8, _F, Key.RNG_GAIN),
-    ParamSpec("LAND_SPEED", 50.0, _F, Key.LAND_SPEED),
-    ParamSpec("ARMING_CHECK", 1.0, _I32),
-    *[
-        ParamSpec(f"RC{ch}_{f}", v, _I16)
-        for ch in range(1, 9)
-        for f, v in (("MIN", 1000.0), ("MAX", 2000.0), ("TRIM", 1000.0 if ch == 3 else 1500.0))
-    ],
-]
-
-N_STREAM_PORTS = 3  # SR0 = TCP, SR1 = serial (pty), SR2 = UDP
-
-PARAM_NOTES = (
-    "FS_GCS_ENABLE defaults to 1 (the thesis flies only from the PC, so a silent GCS must land); "
-    "THR_MID / MOT_THST_HOVER are set from the simulated airframe's hover throttle at start, as "
-    "an owner would have tuned them."
-)
+def _pre_47_name(name: str) -> str:
+    m = _MAVN.match(name)
+    if m:
+        return f"SR{int(m.group(1)) - 1}_{m.group(2)}"
+    return _PRE_47_RENAMES.get(name, name)
 
 
-def param_table(profile: Profile) -> tuple[ParamSpec, ...]:
+def param_table(
+    profile: Profile, options: AutopilotOptions | None = None
+) -> tuple[ParamSpec, ...]:
     """All parameters of a profile, in the order PARAM_REQUEST_LIST sends them."""
-    base = _APM25 if profile is Profile.APM25 else _COPTER4
-    return tuple(base + _stream_specs(N_STREAM_PORTS))
+    table = _firmware_table(profile)
+    if profile is Profile.COPTER4 and options is not None and options.pre_47_names:
+        return tuple(ParamSpec(_pre_47_name(s.name), s.default, s.ptype) for s in table)
+    return table
+
+
+def stream_param_name(profile: Profile, options: AutopilotOptions, port: int, suffix: str) -> str:
+    """The stream-rate parameter of link `port` (0 TCP, 1 serial, 2 UDP): SRn_ or 4.7's MAVn_."""
+    if profile is Profile.COPTER4 and not options.pre_47_names:
+        return f"MAV{port + 1}_{suffix}"
+    return f"SR{port}_{suffix}"
 
 
 class ParamError(ValueError):
@@ -240,11 +249,15 @@ class ParamError(ValueError):
 class ParamStore:
     """Current parameter values of one vehicle, with change counting for cached gains."""
 
-    def __init__(self, profile: Profile) -> None:
+    def __init__(self, profile: Profile, options: AutopilotOptions | None = None) -> None:
         self.profile = profile
-        self._specs = param_table(profile)
+        self.options = options or AutopilotOptions()
+        self._specs = param_table(profile, self.options)
         self._index = {spec.name: i for i, spec in enumerate(self._specs)}
-        self._by_key = {spec.key: spec.name for spec in self._specs if spec.key is not None}
+        keys = _APM25_KEYS if profile is Profile.APM25 else _COPTER4_KEYS
+        rename = _pre_47_name if self.options.pre_47_names and profile is Profile.COPTER4 else str
+        self._by_key = {k: (rename(n), s) for k, (n, s) in keys.items()}
+        self._fixed = FIXED_VALUES[profile]
         self._values = [spec.default for spec in self._specs]
         self.version = 0
 
@@ -255,12 +268,16 @@ class ParamStore:
         return name in self._index
 
     def has_key(self, key: Key) -> bool:
-        """Whether this profile implements the parameter meaning `key`."""
+        """Whether this profile has a parameter for the meaning `key`."""
         return key in self._by_key
 
     def name_of(self, key: Key) -> str:
         """The firmware's name for `key` in this profile."""
-        return self._by_key[key]
+        return self._by_key[key][0]
+
+    def stream_param(self, port: int, suffix: str) -> str:
+        """Stream-rate parameter name of link `port` for group `suffix`."""
+        return stream_param_name(self.profile, self.options, port, suffix)
 
     def spec(self, index: int) -> ParamSpec:
         """The spec at `index` (PARAM_REQUEST_READ by index)."""
@@ -285,8 +302,12 @@ class ParamStore:
         return self._values[index]
 
     def k(self, key: Key) -> float:
-        """Value by meaning."""
-        return self._values[self._index[self._by_key[key]]]
+        """Value by meaning, in the SITL's unit (a fixed value where the firmware has none)."""
+        entry = self._by_key.get(key)
+        if entry is None:
+            return self._fixed[key]
+        name, scale = entry
+        return self._values[self._index[name]] * scale
 
     def set(self, name: str, value: float) -> float:
         """Set by name (integer types rounded as AP_Param stores them); returns the stored value."""
@@ -299,10 +320,13 @@ class ParamStore:
             stored = min(127.0, max(-128.0, stored))
         elif spec.ptype is ParamType.INT16:
             stored = min(32767.0, max(-32768.0, stored))
+        elif spec.ptype is ParamType.INT32:
+            stored = min(2147483647.0, max(-2147483648.0, stored))
         self._values[i] = stored
         self.version += 1
         return stored
 
     def set_key(self, key: Key, value: float) -> float:
-        """Set by meaning."""
-        return self.set(self._by_key[key], value)
+        """Set by meaning, `value` in the SITL's unit; returns the stored firmware value."""
+        name, scale = self._by_key[key]
+        return self.set(name, value / scale)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+from dataclasses import dataclass
 
 
 class Profile(enum.Enum):
@@ -40,3 +41,38 @@ KNOWN_UNSUPPORTED_MODES: dict[int, str] = {
     16: "POSHOLD",
     17: "BRAKE",
 }
+
+COPTER4_VERSIONS = ("4.7", "4.6")  # 4.6 stands for any 4.x before 4.7's parameter renames
+PREARM_BOOT_S_SHORT = 3.0  # copter4 pre-arm delay by default: short, so tests stay fast
+PREARM_BOOT_S_REALISTIC = 24.0  # measured on 4.7-dev SITL: arming passes ≈ 23–24 s after boot
+
+
+@dataclass(frozen=True)
+class AutopilotOptions:
+    """Choices a world file (`[autopilot]`) or the command line makes about the firmware.
+
+    `realistic_boot`: copter4 refuses to arm ("Arm: Accels inconsistent") for the real ≈ 24 s
+    after boot instead of the short default. `copter4_version` "4.6": the parameter names of a
+    4.x before 4.7 (SYSID_MYGCS, SYSID_THISMAV, SRn_*) instead of 4.7's (MAV_GCS_SYSID,
+    MAV_SYSID, MAVn_*).
+    """
+
+    realistic_boot: bool = False
+    copter4_version: str = "4.7"
+
+    def __post_init__(self) -> None:
+        if self.copter4_version not in COPTER4_VERSIONS:
+            raise ValueError(
+                f"copter4_version: expected one of {', '.join(COPTER4_VERSIONS)}, "
+                f"got {self.copter4_version!r}"
+            )
+
+    @property
+    def pre_47_names(self) -> bool:
+        """Whether a copter4 uses the parameter names from before 4.7."""
+        return self.copter4_version != "4.7"
+
+    @property
+    def copter4_prearm_s(self) -> float:
+        """How long after boot a copter4 refuses to arm."""
+        return PREARM_BOOT_S_REALISTIC if self.realistic_boot else PREARM_BOOT_S_SHORT

@@ -46,6 +46,7 @@ class Channel:
         self.sent = 0
         self.has_gcs = False
         self.pending_params: deque[int] = deque()
+        self.next_param_s = 0.0  # 3.2.1 paces its parameter download
         self.apply_signing(view.signing_key)
 
     def apply_signing(self, key: bytes | None) -> None:

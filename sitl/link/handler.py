@@ -2,8 +2,15 @@
 
 Per-profile rules: Copter 3.2.1 changes mode only by SET_MODE (MAV_CMD_DO_SET_MODE is
 UNSUPPORTED) and has no SET_MESSAGE_INTERVAL or signing; Copter 4.x has all three. Overrides are
-taken only from SYSID_MYGCS addressed to this vehicle. Replies go to the link that asked;
-PARAM_VALUE after a PARAM_SET and STATUSTEXT go to every link, as ArduPilot broadcasts them.
+taken only from the GCS system id (SYSID_MYGCS; MAV_GCS_SYSID on 4.7) addressed to this vehicle.
+Replies go to the link that asked; PARAM_VALUE after a PARAM_SET and STATUSTEXT go to every link,
+as ArduPilot broadcasts them.
+
+Parameter downloads: 3.2.1 sends about 25 PARAM_VALUE a second (3 per trigger of its SRn_PARAMS
+stream, measured: 412 in 16.6 s) and slows its other streams to a quarter meanwhile; 4.x sends
+its 1364 in about a second. PARAM_REQUEST_LIST first sends the firmware's version and frame
+texts, as both do. While 3.2.1 is arming (its main loop blocked ≈ 1.9 s) only HEARTBEAT and
+SYS_STATUS go out, once a second, and the COMMAND_ACK comes when arming is done.
 """
 
 from __future__ import annotations
@@ -15,6 +22,7 @@ from typing import Any
 from sitl.autopilot import Key, ParamError, Profile
 from sitl.companion import Companion
 from sitl.link import telemetry as tm
+from sitl.link import telemetry_full
 from sitl.link.channel import Channel
 from sitl.link.codec import mavlink
 from sitl.link.view import VehicleView
@@ -27,7 +35,9 @@ MAV_RESULT_FAILED = 4
 MAV_RESULT_UNSUPPORTED = 3
 MAV_RESULT_DENIED = 2
 MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
-PARAMS_PER_TICK = 20
+PARAMS_PER_TICK = 20  # 4.x: 2000 a second at the 100 Hz tick, bounded by the queue below
+APM25_PARAMS_PER_SLOT = 3
+APM25_PARAM_PERIOD_S = 0.12  # SRn_PARAMS 10 → 50/6 Hz triggers, 3 each ≈ 25 a second
 PARAM_QUEUE_LIMIT_BYTES = 1024
 
 _BUILDERS: dict[str, Callable[[VehicleView], Any]] = {
@@ -42,6 +52,7 @@ _BUILDERS: dict[str, Callable[[VehicleView], Any]] = {
     "RANGEFINDER": tm.rangefinder,
     "DISTANCE_SENSOR": tm.distance_sensor_down,
     "SIM_STATE": tm.sim_state,
+    **telemetry_full.BUILDERS,
 }
 
 
@@ -59,6 +70,7 @@ class VehicleLink:
         self.channels: list[Channel] = []
         self.companion = companion or Companion()
         self._next_heartbeat_s = 0.0
+        self._pending_arm: list[tuple[Channel, int, int]] = []  # who asked a 3.2.1 to arm
 
     def add_channel(
         self, port: int, name: str, truth_max_rate_hz: float = math.inf
@@ -96,21 +108,21 @@ class VehicleLink:
             if src == gcs_id and msg.target_system == v.sysid:
                 values = [getattr(msg, f"chan{i}_raw") for i in range(1, 9)]
                 ap.rc_override(values, t)
-                if v.profile is Profile.COPTER4:
-                    ap.gcs_seen(t)
         elif kind == "SET_MODE":
             if msg.target_system == v.sysid:
                 ok = bool(msg.base_mode & MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
                 res = ap.set_mode(msg.custom_mode) if ok else None
                 accepted = res is not None and res.accepted
                 if res is not None and res.text:
-                    self.broadcast_text(4, res.text)
+                    self.broadcast_text(res.severity, res.text)
                 self._ack(ch, msg, mavlink.MAVLINK_MSG_ID_SET_MODE, accepted)
         elif kind == "COMMAND_LONG":
             if self._for_me(msg.target_system):
                 self._command_long(ch, msg)
         elif kind == "PARAM_REQUEST_LIST":
             if self._for_me(msg.target_system):
+                for severity, text in ap.version_texts():
+                    self.broadcast_text(severity, text)
                 ch.pending_params.clear()
                 ch.pending_params.extend(range(len(v.params)))
         elif kind == "PARAM_REQUEST_READ":
@@ -176,13 +188,16 @@ class VehicleLink:
                 self._ack(ch, msg, cmd, False, MAV_RESULT_UNSUPPORTED)
                 return
             if res.text:
-                self.broadcast_text(2, res.text)
-            self._ack(ch, msg, cmd, res.accepted)
+                self.broadcast_text(res.severity, res.text)
+            if res.pending:
+                self._pending_arm.append((ch, msg.get_srcSystem(), msg.get_srcComponent()))
+                return
+            self._ack(ch, msg, cmd, res.accepted, res.result)
         elif cmd == MAV_CMD_DO_SET_MODE and v.profile is Profile.COPTER4:
             if int(msg.param1) & MAV_MODE_FLAG_CUSTOM_MODE_ENABLED:
                 res = ap.set_mode(int(msg.param2))
                 if res.text:
-                    self.broadcast_text(4, res.text)
+                    self.broadcast_text(res.severity, res.text)
                 self._ack(ch, msg, cmd, res.accepted)
             else:
                 self._ack(ch, msg, cmd, False, MAV_RESULT_DENIED)
@@ -210,33 +225,56 @@ class VehicleLink:
     def tick(self, t_s: float) -> None:
         """Emit what is due at `t_s`: heartbeat, queued texts, parameters, streams, companion."""
         v = self.view
-        for severity, text in v.autopilot.texts:
+        ap = v.autopilot
+        for severity, text in ap.texts:
             self.broadcast_text(int(severity), text)
-        v.autopilot.texts.clear()
+        ap.texts.clear()
+        if ap.arm_completed is not None:
+            for ch, sysid, compid in self._pending_arm:
+                ch.send_reply(
+                    mavlink.MAVLink_command_ack_message(
+                        MAV_CMD_COMPONENT_ARM_DISARM, MAV_RESULT_ACCEPTED, 0, 0, sysid, compid
+                    )
+                )
+            self._pending_arm.clear()
+            ap.arm_completed = None
+        blocked = ap.arming_in_progress
         if t_s + 1e-9 >= self._next_heartbeat_s:
             self._next_heartbeat_s = max(self._next_heartbeat_s + 1.0, t_s)
             hb = tm.heartbeat(v)
             for c in self.channels:
                 c.send_reply(hb)
+                if blocked:  # 3.2.1's mavlink_delay_cb: heartbeat and SYS_STATUS only
+                    c.send_telemetry(tm.sys_status(v, c.drop_rate_comm, c.errors_comm))
         companion_msgs = self.companion.due(v, t_s) if any(c.has_gcs for c in self.channels) else []
         cache: dict[str, Any] = {}
         for c in self.channels:
-            n = 0
-            while (
-                c.pending_params
-                and n < PARAMS_PER_TICK
-                and c.queued_bytes() < PARAM_QUEUE_LIMIT_BYTES
-            ):
-                c.send_reply(self._param_value(c.pending_params.popleft()))
-                n += 1
-            for name in c.streams.due(t_s):
-                if name == "SYS_STATUS":
-                    c.send_telemetry(tm.sys_status(v, c.drop_rate_comm, c.errors_comm))
-                    continue
-                msg = cache.get(name)
-                if msg is None:
-                    msg = cache[name] = _BUILDERS[name](v)
-                c.send_telemetry(msg)
+            self._send_params(c, t_s)
+            if not blocked:
+                for name in c.streams.due(t_s, params_pending=bool(c.pending_params)):
+                    if name == "SYS_STATUS":
+                        c.send_telemetry(tm.sys_status(v, c.drop_rate_comm, c.errors_comm))
+                        continue
+                    msg = cache.get(name)
+                    if msg is None:
+                        msg = cache[name] = _BUILDERS[name](v)
+                    c.send_telemetry(msg)
             if c.has_gcs:
                 for m in companion_msgs:
                     c.send_telemetry(m, companion=True)
+
+    def _send_params(self, c: Channel, t_s: float) -> None:
+        """Pace a parameter download as the firmware does."""
+        if not c.pending_params:
+            return
+        if self.view.profile is Profile.APM25:
+            if t_s + 1e-9 < c.next_param_s:
+                return
+            c.next_param_s = t_s + APM25_PARAM_PERIOD_S
+            budget = APM25_PARAMS_PER_SLOT
+        else:
+            budget = PARAMS_PER_TICK
+        n = 0
+        while c.pending_params and n < budget and c.queued_bytes() < PARAM_QUEUE_LIMIT_BYTES:
+            c.send_reply(self._param_value(c.pending_params.popleft()))
+            n += 1

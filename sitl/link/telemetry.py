@@ -6,8 +6,9 @@ mrad/s, body FRD: this is what ArduPilot's send_raw_imu writes for every IMU inc
 with a_mss = xacc · 9.80665e-3 and w_rads = xgyro · 1e-3. (The thesis's eq. 5.1 converts the
 chip's LSB/g counts on its own Arduino; behind ArduPilot that conversion has already happened.)
 Ground truth goes out as SIM_STATE only (attitude quaternion and Euler angles, body acceleration
-and rates, lat/lng, altitude, NED velocity), on both profiles: it is a MAVLink 1 message, and
-SIMSTATE would add nothing but bytes (it has no altitude). See `sitl.link.streams` for its rate.
+and rates, lat/lng, altitude, NED velocity), on both profiles, in the slot where the real SITL
+builds send SIMSTATE (which has no altitude). See `sitl.link.streams` for its rate. The rest of
+the real firmware's stream sets is built in `sitl.link.telemetry_full`.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from sitl.autopilot import FlightMode, Profile
+from sitl.autopilot import FlightMode, Key, Profile
 from sitl.link.codec import mavlink
 from sitl.link.view import VehicleView
 
@@ -47,7 +48,7 @@ def heartbeat(v: VehicleView) -> Any:
     st = v.autopilot.state
     if st.armed:
         base_mode = BASE_MODE_ARMED
-    elif not v.autopilot.calibrated:
+    elif v.autopilot.booting:
         base_mode = BASE_MODE_BOOT
     else:
         base_mode = BASE_MODE_DISARMED
@@ -173,21 +174,32 @@ def servo_output_raw(v: VehicleView) -> Any:
     )
 
 
-def rangefinder(v: VehicleView) -> Any:
-    """RANGEFINDER (3.2.1): distance in m, 0 when there is no echo."""
+def rangefinder_cm(v: VehicleView) -> int:
+    """The down sonar as the autopilot reports it: whole centimetres (AP_RangeFinder keeps
+    distance_cm as an integer), 0 without an echo or outside RNGFND min..max (so 0 on the floor,
+    below the minimum, as both real firmwares read on the ground)."""
     d = v.cache.sonar_m
-    return mavlink.MAVLink_rangefinder_message(d if d is not None else 0.0, 0.0)
+    if d is None:
+        return 0
+    cm = round(d * 100.0)
+    lo = round(v.params.k(Key.RNG_MIN_M) * 100.0)
+    hi = round(v.params.k(Key.RNG_MAX_M) * 100.0)
+    return cm if lo <= cm <= hi else 0
+
+
+def rangefinder(v: VehicleView) -> Any:
+    """RANGEFINDER: metres as a float32 of whole centimetres / 100 (3.2.1's distance_cm * 0.01)."""
+    return mavlink.MAVLink_rangefinder_message(rangefinder_cm(v) * 0.01, 0.0)
 
 
 def distance_sensor_down(v: VehicleView) -> Any:
-    """DISTANCE_SENSOR for the down sonar (4.x)."""
-    d = v.cache.sonar_m
-    cm = round(d * 100.0) if d is not None else 0
+    """DISTANCE_SENSOR for the down sonar (4.x): uint16 centimetres."""
+    p = v.params
     return mavlink.MAVLink_distance_sensor_message(
         _boot_ms(v),
-        int(v.sonar_min_m * 100),
-        int(v.sonar_max_m * 100),
-        cm,
+        round(p.k(Key.RNG_MIN_M) * 100.0),
+        round(p.k(Key.RNG_MAX_M) * 100.0),
+        rangefinder_cm(v),
         MAV_DISTANCE_SENSOR_ULTRASOUND,
         0,
         MAV_SENSOR_ROTATION_PITCH_270,

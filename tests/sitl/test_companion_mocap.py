@@ -52,7 +52,7 @@ def test_mocap_delivers_100_hz_per_vehicle_with_latency(n: int) -> None:
 def test_vehicles_have_their_own_system_ids() -> None:
     sim = Simulation(big_room(), Profile.COPTER4, 2, seed=2)
     gcs2 = MemoryGcs(sim, sim.memory_link(2), mavlink1=False)
-    gcs2.send(mavlink.MAVLink_param_request_read_message(2, 1, b"SYSID_THISMAV", -1))
+    gcs2.send(mavlink.MAVLink_param_request_read_message(2, 1, b"MAV_SYSID", -1))  # 4.7 name
     msgs = gcs2.run(1.1)
     assert {m.get_srcSystem() for m in msgs} == {2}
     assert gcs2.of_type("PARAM_VALUE", msgs)[0].param_value == 2.0
