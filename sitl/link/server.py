@@ -21,6 +21,7 @@ from sitl.link.endpoints import (
 )
 from sitl.mocap_server import MocapServer
 from sitl.simulation import Simulation
+from sitl.truth_server import TruthServer
 
 TCP_BASE_PORT = 5760
 PORT_STRIDE = 10  # vehicle i listens on base + 10·(i − 1), as ArduPilot's --instance
@@ -39,6 +40,7 @@ class EndpointPlan:
     serial: bool = False
     mocap_port: int | None = None  # None = no mocap server
     serial_truth_max_rate_hz: float = SERIAL_TRUTH_MAX_RATE_HZ
+    truth_port: int | None = None  # None = no evaluation truth endpoint (sitl.truth_server)
 
 
 class SitlServer:
@@ -49,6 +51,7 @@ class SitlServer:
         self.speedup = speedup
         self.endpoints: list[tuple[int, Endpoint]] = []
         self.mocap: MocapServer | None = None
+        self.truth: TruthServer | None = None
         self._stop = threading.Event()
         self.ticks = 0
         self.resyncs = 0
@@ -75,12 +78,16 @@ class SitlServer:
                 )
         if plan.mocap_port is not None:
             self.mocap = MocapServer(plan.mocap_port, mavlink1=not self.sim.profile.mavlink2)
+        if plan.truth_port is not None:
+            self.truth = TruthServer(plan.truth_port, mavlink1=not self.sim.profile.mavlink2)
 
     def address_lines(self) -> list[str]:
         """The stdout contract: one line per endpoint (without the final `ready`)."""
         lines = [f"vehicle {sysid} {ep.describe()}" for sysid, ep in self.endpoints]
         if self.mocap is not None:
             lines.append(f"mocap {self.mocap.describe()}")
+        if self.truth is not None:
+            lines.append(f"truth {self.truth.describe()}")
         return lines
 
     def stop(self) -> None:
@@ -105,6 +112,9 @@ class SitlServer:
             if self.mocap is not None:
                 for fd in self.mocap.fileno_list():
                     fd_map[fd] = self.mocap
+            if self.truth is not None:
+                for fd in self.truth.fileno_list():
+                    fd_map[fd] = self.truth
             wait = max(0.0, clock.seconds_until(sim.t_s + sim.dt_s))
             readable, _, _ = select.select(list(fd_map), [], [], min(wait, 0.05))
             for fd in readable:
@@ -118,6 +128,8 @@ class SitlServer:
                 self.mocap.publish(sim.take_mocap())
             else:
                 sim.take_mocap()
+            if self.truth is not None:
+                self.truth.publish(sim.t_s, sim.vehicles)
             now = time.monotonic()
             for _, ep in self.endpoints:
                 # the radio runs at its baud rate in simulated time: a sped-up run must not
@@ -136,3 +148,6 @@ class SitlServer:
         if self.mocap is not None:
             self.mocap.close()
             self.mocap = None
+        if self.truth is not None:
+            self.truth.close()
+            self.truth = None
