@@ -120,6 +120,18 @@ def distinct_reports(t_s: Sequence[float], alt_m: Sequence[float | None]) -> Ser
     return Series.of(out_t, out_a)
 
 
+def station_time(rx_s: Sequence[float], t_s: Sequence[float], alt_m: Sequence[float]) -> Series:
+    """Reports stamped with the sender's clock (`t_s`) and received at `rx_s` on the station's,
+    as a Series on the station's clock: shifted by the smallest receive delay seen, so the
+    link's jitter does not move them (both clocks run at the same rate, sped up or not)."""
+    rx = np.asarray(rx_s, dtype=float)
+    t = np.asarray(t_s, dtype=float)
+    if not t.size:
+        return Series.of([], [])
+    order = np.argsort(t, kind="stable")
+    return Series(t[order] + float(np.min(rx - t)), np.asarray(alt_m, dtype=float)[order])
+
+
 def covered_fraction(report_t_s: np.ndarray, t0_s: float, t1_s: float,
                      max_age_s: float = MAX_TRUTH_AGE_S) -> float:
     """Share of [t0_s, t1_s] within `max_age_s` after some report (reports may start earlier)."""

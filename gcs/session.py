@@ -16,6 +16,7 @@ from typing import Any
 
 from firmware_link import LinkUsageError, MocapLink, ParamError, VehicleLink, load_signing_key
 from firmware_link.records import Battery, Dialect, MocapPose
+from firmware_link.truth_link import TruthLink, TruthRecorder
 from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import load_config
 from gcs.errors import UsageError
@@ -26,6 +27,8 @@ from gcs.thrust_curve import ThrottleCurve
 
 CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
 STREAM_RATE_HZ = 40.0
+# commands that score a flight get the bundled SITL's ground-truth endpoint (gcs.scoring)
+SCORED_COMMANDS = frozenset({"fly"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -82,6 +85,8 @@ class Vehicle:
     link: VehicleLink
     station: Station
     recorder: Any | None
+    # the bundled SITL's ground truth, for scoring only: nothing that flies reads it
+    truth: TruthRecorder | None = None
 
 
 class StationSession:
@@ -148,7 +153,8 @@ class StationSession:
             sitl = SitlProcess(SitlOptions(profile=o.profile, world=o.world,
                                            vehicles=max(o.sysids), speedup=o.speedup,
                                            serial=o.serial, seed=o.seed,
-                                           signing_key=o.signing_key))
+                                           signing_key=o.signing_key,
+                                           truth=o.command in SCORED_COMMANDS))
             self.sitl_endpoints = sitl.start()
             self._stack.callback(sitl.stop)
             urls = {s: self.sitl_endpoints.url(s, serial=o.serial) for s in o.sysids}
@@ -157,6 +163,11 @@ class StationSession:
             urls = {o.sysids[0]: o.connect}
         for sysid, url in urls.items():
             self.vehicles[sysid] = self._open_vehicle(sysid, url, mocap_url, key, config)
+        truth_url = getattr(self.sitl_endpoints, "truth", None)
+        if truth_url is not None:
+            for sysid, v in self.vehicles.items():
+                v.truth = TruthRecorder(TruthLink.open(truth_url, clock=self.clock.now_s), sysid)
+                self._stack.callback(v.truth.close)
 
     def _open_vehicle(self, sysid: int, url: str, mocap_url: str | None, key: bytes | None,
                       config: Any) -> Vehicle:

@@ -2,7 +2,8 @@
 
 The SITL prints one line per endpoint (`vehicle <sysid> tcp:127.0.0.1:<port>`,
 `vehicle <sysid> serial:<path>`, `vehicle <sysid> udp:<host>:<port>`,
-`mocap tcp:127.0.0.1:<port>`) and then `ready`. The station never imports `sitl`: it speaks to it
+`mocap tcp:127.0.0.1:<port>`, with `truth=True` also `truth tcp:127.0.0.1:<port>`: its
+evaluation-only ground truth) and then `ready`. The station never imports `sitl`: it speaks to it
 only over MAVLink, as it would to a real vehicle.
 """
 
@@ -24,6 +25,7 @@ from gcs.errors import RuntimeFault
 
 _VEHICLE = re.compile(r"^vehicle (\d+) ((?:tcp|udp|serial):\S+)$")
 _MOCAP = re.compile(r"^mocap (tcp:\S+)$")
+_TRUTH = re.compile(r"^truth (tcp:\S+)$")
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,6 +40,7 @@ class SitlOptions:
     seed: int | None = None
     signing_key: Path | None = None
     no_noise: bool = False
+    truth: bool = False  # open the ground-truth endpoint (for scoring only)
     extra_args: tuple[str, ...] = ()
 
 
@@ -47,6 +50,7 @@ class SitlEndpoints:
 
     vehicles: dict[int, tuple[str, ...]] = field(default_factory=dict)
     mocap: str | None = None
+    truth: str | None = None
 
     def url(self, sysid: int = 1, serial: bool = False) -> str:
         """The vehicle's serial (pty path) or TCP connection string."""
@@ -60,7 +64,8 @@ class SitlEndpoints:
         raise RuntimeFault(f"bundled SITL printed no {kind} endpoint for vehicle {sysid}")
 
 
-def parse_line(line: str, ep: dict[int, list[str]], mocap: list[str]) -> bool:
+def parse_line(line: str, ep: dict[int, list[str]], mocap: list[str],
+               truth: list[str] | None = None) -> bool:
     """Absorb one stdout line; True when it was `ready`."""
     line = line.strip()
     if line == "ready":
@@ -70,6 +75,8 @@ def parse_line(line: str, ep: dict[int, list[str]], mocap: list[str]) -> bool:
         ep.setdefault(int(m.group(1)), []).append(m.group(2))
     elif (m := _MOCAP.match(line)) is not None:
         mocap.append(m.group(1))
+    elif truth is not None and (m := _TRUTH.match(line)) is not None:
+        truth.append(m.group(1))
     return False
 
 
@@ -98,6 +105,8 @@ class SitlProcess:
             argv += ["--signing-key", str(o.signing_key)]
         if o.no_noise:
             argv.append("--no-noise")
+        if o.truth:
+            argv += ["--truth-port", "0"]
         return argv + list(o.extra_args)
 
     def start(self) -> SitlEndpoints:
@@ -113,6 +122,7 @@ class SitlProcess:
         assert self.proc.stdout is not None
         eps: dict[int, list[str]] = {}
         mocap: list[str] = []
+        truth: list[str] = []
         sel = selectors.DefaultSelector()
         sel.register(self.proc.stdout, selectors.EVENT_READ)
         fd = self.proc.stdout.fileno()
@@ -138,9 +148,10 @@ class SitlProcess:
                 buf += chunk
                 *lines, buf = buf.split(b"\n")
                 for raw in lines:
-                    if parse_line(raw.decode(errors="replace"), eps, mocap):
+                    if parse_line(raw.decode(errors="replace"), eps, mocap, truth):
                         self.endpoints = SitlEndpoints(
-                            {k: tuple(v) for k, v in eps.items()}, mocap[0] if mocap else None)
+                            {k: tuple(v) for k, v in eps.items()}, mocap[0] if mocap else None,
+                            truth[0] if truth else None)
                         if not self.endpoints.vehicles:
                             raise RuntimeFault("bundled SITL was ready but printed no endpoint")
                         # keep draining stdout so a chatty SITL never blocks on a full pipe
