@@ -50,7 +50,8 @@ class Phase(enum.Enum):
 
 _S = SupervisorState
 PHASE_STATES: dict[Phase, frozenset[SupervisorState]] = {
-    Phase.ARMED: frozenset({_S.MANUAL}),
+    # the take-off request is applied at the next tick: until then the supervisor says MANUAL
+    Phase.ARMED: frozenset({_S.MANUAL, _S.SPOOL_UP, _S.TAKEOFF, _S.HOLD}),
     Phase.TAKEOFF: frozenset({_S.SPOOL_UP, _S.TAKEOFF, _S.HOLD}),
     Phase.SETTLE: frozenset({_S.HOLD}),
     Phase.HOLD: frozenset({_S.HOLD}),
@@ -245,9 +246,19 @@ class FlightRunner:
         self.phase = Phase.ARMED
         if p.takeoff_delay_s > 0.0:
             self.pause(p.takeoff_delay_s)
-        self.phase = Phase.TAKEOFF
         self._target = p.alt_m
+        asked_at = st.clock.now_s()
         st.alt_hold(True, p.alt_m, rate_mps=p.climb_mps)
+
+        def taking_off(s: StationSnapshot) -> bool:
+            refused = [e for e in s.events if e.t_s >= asked_at
+                       and e.text.startswith("altitude hold refused")]
+            if refused:
+                raise FlightFailed(refused[-1].text)
+            return s.state is not SupervisorState.MANUAL
+
+        self.wait("take-off request", taking_off, 2.0)
+        self.phase = Phase.TAKEOFF
         pose = st.snapshot(loop_stats=False).mocap
         if pose is not None:
             # with motion capture, hold the take-off spot and heading: without it the vehicle

@@ -189,8 +189,7 @@ class _Flight:
                 last = (now, z)
             time.sleep(0.1)
         st.set_sticks(1500, 1500, 1500, 1000)
-        st.alt_hold(False)
-        st.set_mode(FlightMode.LAND)
+        st.set_mode(FlightMode.LAND)  # PC hold stays on until a heartbeat shows LAND
         for _ in range(4):
             if c.wait(lambda s: not s.armed, 10.0):
                 return
@@ -484,8 +483,8 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
                 outcome = _radiation(f, setup, hover, mw)
             f.land()  # whatever `flight.land` says: closing the session releases the sticks
         except BaseException:
-            for c in crafts.values():
-                c.station.kill()
+            for c in crafts.values():  # all at once; leaving the session waits for each LAND
+                c.station.quit()
             raise
         collisions, truth_metrics = _truth_books(crafts, mw)
         status, reason = outcome.status, outcome.reason

@@ -178,7 +178,8 @@ class Supervisor:
         elif k is IntentKind.KILL:
             self._kill_at_s = self._t
             self._end_pc_control()
-            self._go(S.KILLED, "pilot kill: throttle minimum, disarm until seen", Level.WARNING)
+            self._go(S.KILLED, "KILL: throttle minimum, disarm until a heartbeat says disarmed",
+                     Level.WARNING)
         elif k is IntentKind.PREFLIGHT:
             self.preflight_ok, self.preflight_note = it.ok, it.note
             self._note(Level.INFO if it.ok else Level.WARNING,

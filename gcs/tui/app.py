@@ -19,7 +19,7 @@ from textual.widgets import Footer, RichLog
 
 from gcs.tui import intents
 from gcs.tui.backend import TeleopBackend
-from gcs.tui.help import HelpScreen, describe
+from gcs.tui.help import ConfirmQuit, HelpScreen, describe
 from gcs.tui.sticks import Sticks
 from gcs.tui.view import TeleopView
 from gcs.tui.widgets import AccelPlot, AltitudePanel, HeightPlot, LinkPanel, VehiclePanel
@@ -222,6 +222,18 @@ class LiveTeleopApp(TeleopApp):
     """Teleop of a live vehicle."""
 
     BINDINGS = LIVE_BINDINGS
+
+    async def action_quit(self) -> None:
+        """Quit at once when disarmed; with the vehicle armed, ask first (quitting lands it)."""
+        if not self.backend.view().vehicle.armed:
+            self.exit()
+            return
+
+        def answered(quit_: bool | None) -> None:
+            if quit_:
+                self.exit()
+
+        self.push_screen(ConfirmQuit(), answered)
 
 
 class ReplayApp(TeleopApp):

@@ -43,3 +43,25 @@ class HelpScreen(ModalScreen[None]):
             yield Static("Key bindings", id="help-title")
             yield Static(self._text, id="help-body")
             yield Static("Press Esc or ? to close.", id="help-foot")
+
+
+class ConfirmQuit(ModalScreen[bool]):
+    """Quitting with the vehicle armed: say what will happen, and ask."""
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        ("y", "answer(True)", "Land and quit"),
+        ("n,escape", "answer(False)", "Stay"),
+    ]
+
+    def compose(self) -> ComposeResult:
+        """One bordered question."""
+        with Vertical(id="help-box"):
+            yield Static("The vehicle is ARMED", id="help-title")
+            yield Static("Quitting lands it first (LAND mode, confirmed by its heartbeat),\n"
+                         "then hands the sticks back. A lost link leaves it to its own failsafe.",
+                         id="help-body")
+            yield Static("y: land and quit    n / Esc: stay", id="help-foot")
+
+    def action_answer(self, quit_: bool) -> None:
+        """Close with the pilot's answer."""
+        self.dismiss(quit_)

@@ -34,6 +34,8 @@ def _child(options: SessionOptions, conn: Connection) -> None:
 
     # The terminal's Ctrl-C belongs to the UI; the station stops when the UI tells it to.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # terminated, unwind like a closed pipe: leaving the session lands a flying vehicle
+    signal.signal(signal.SIGTERM, _unwind)
     try:
         with StationSession(options) as session:
             v = session.first
@@ -64,6 +66,10 @@ def _child(options: SessionOptions, conn: Connection) -> None:
         _try_send(conn, ("error", str(exc), exc.exit_code))
     except LinkError as exc:
         _try_send(conn, ("error", str(exc), 1))
+
+
+def _unwind(signum: int, frame: object) -> None:
+    raise EOFError(f"signal {signum}")
 
 
 def _try_send(conn: Connection, msg: Any) -> None:
@@ -135,8 +141,9 @@ class ProcessBackend:
         except (BrokenPipeError, OSError):
             self.error = ("station process ended", 1)
 
-    def close(self, timeout_s: float = 10.0) -> None:
-        """Ask the station to stop (it releases overrides) and wait for its process."""
+    def close(self, timeout_s: float = 20.0) -> None:
+        """Ask the station to stop and wait for its process (a flying vehicle is landed first,
+        up to the supervisor's quit timeout, before the overrides are released)."""
         if self._closed:
             return
         self._closed = True

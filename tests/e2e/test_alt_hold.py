@@ -20,7 +20,9 @@ pytestmark = [pytest.mark.e2e, pytest.mark.timeout(240)]
 
 
 def fly_json(*argv: str) -> dict[str, Any]:
-    args = build_parser().parse_args(["fly", "--no-record", "--seed", "3", *argv])
+    # the pilot consents to the station setting the GCS failsafe (copter4 ships it off)
+    args = build_parser().parse_args(["fly", "--no-record", "--seed", "3", "--fix-failsafe",
+                                      *argv])
     return fly(args)
 
 
