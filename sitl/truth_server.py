@@ -13,6 +13,7 @@ moment it connects; what clients send is ignored.
 
 from __future__ import annotations
 
+import math
 import socket
 from collections.abc import Sequence
 
@@ -38,7 +39,7 @@ class TruthServer:
         self._codec = MavCodec(TRUTH_SYSID, 1, mavlink1)
         self._clients: dict[int, tuple[socket.socket, bytearray]] = {}
         self._period_s = 1.0 / rate_hz
-        self._next_s = 0.0
+        self._next_s: float | None = None  # the next report's time, on the rate's grid
         self.sent = 0
 
     def fileno_list(self) -> list[int]:
@@ -75,9 +76,13 @@ class TruthServer:
     def publish(self, t_s: float, vehicles: Sequence[VehicleRuntime]) -> None:
         """After a simulation tick at `t_s`: queue a report of every vehicle when one is due,
         then send what the sockets take."""
+        period = self._period_s
+        if self._next_s is None:
+            self._next_s = math.ceil(t_s / period - 1e-6) * period
         if t_s + 1e-9 >= self._next_s:
-            # on the rate's grid, so the reports do not drift against the 100 Hz tick
-            self._next_s = max(self._next_s + self._period_s, t_s)
+            # on the rate's grid (multiples of the period), so reports are evenly spaced in
+            # simulated time whatever the tick, and after a stall the grid resumes
+            self._next_s = (math.floor(t_s / period + 1e-6) + 1) * period
             if self._clients:
                 self._queue(t_s, vehicles)
         self._send()
