@@ -21,6 +21,7 @@ from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import load_config
 from gcs.errors import UsageError
 from gcs.preflight import PreflightReport, read_and_check
+from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlOptions, SitlProcess
 from gcs.station import Station
 from gcs.thrust_curve import ThrottleCurve
@@ -87,6 +88,15 @@ class Vehicle:
     recorder: Any | None
     # the bundled SITL's ground truth, for scoring only: nothing that flies reads it
     truth: TruthRecorder | None = None
+
+    def truth_series(self) -> Series | None:
+        """The truth endpoint's reports so far as altitudes above the floor on the station's
+        clock; None without the endpoint (a score then uses the link's SIM_STATE, if any)."""
+        reports = self.truth.reports() if self.truth is not None else []
+        if not reports:
+            return None
+        return station_time([r.rx_s for r in reports], [r.t_s for r in reports],
+                            [r.alt_m for r in reports])
 
 
 class StationSession:

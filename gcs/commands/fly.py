@@ -19,8 +19,7 @@ from gcs.clock import Clock
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
 from gcs.errors import FlightFailed, UsageError
 from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
-from gcs.scoring import Series, station_time
-from gcs.session import StationSession, Vehicle
+from gcs.session import StationSession
 from gcs.station import StationSnapshot
 
 
@@ -80,18 +79,6 @@ class LivePrinter:
             f"{'ARMED' if snap.armed else 'disarmed'}{' LINK LOST' if snap.link_lost else ''}",
             flush=True,
         )
-
-
-def _endpoint_truth(v: Vehicle) -> Series | None:
-    """The bundled SITL's truth endpoint's reports, on the station's clock (None without it:
-    the summary then scores the SIM_STATE the vehicle sent on its link, if any)."""
-    if v.truth is None:
-        return None
-    reports = v.truth.reports()
-    if not reports:
-        return None
-    return station_time([r.rx_s for r in reports], [r.t_s for r in reports],
-                        [r.alt_m for r in reports])
 
 
 def _metres(x: float) -> float | None:
@@ -183,8 +170,9 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
             snap = v.station.snapshot(loop_stats=False)
             raise FlightFailed(f"{exc}; link down {snap.link_down_s:.1f} s; recording "
                                f"{path or 'off'}") from None
-        d = _summary_dict(runner.summary(_endpoint_truth(v)), path, v.link.dialect)
+        d = _summary_dict(runner.summary(v.truth_series()), path, v.link.dialect)
         d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
+        d["status"] = "ok"
         rms = d.get("rms_error_m")
         if not isinstance(rms, float) or not math.isfinite(rms) or rms > ABSURD_RMS_M:
             raise FlightFailed(f"hold error {rms} m is not a flight that went as commanded "
@@ -201,7 +189,6 @@ def run(args: argparse.Namespace) -> int:
             json.dump({"status": "failed", "reason": str(exc)}, sys.stdout)
             print()
         raise
-    d["status"] = "ok"
     if args.json:
         json.dump(d, sys.stdout)
         print()
