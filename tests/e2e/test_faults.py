@@ -40,7 +40,7 @@ FLIGHT_FAILED_EXIT = 3
 
 
 @pytest.fixture(scope="module")
-def flights(request: pytest.FixtureRequest) -> dict[FlightSpec, FlightResult]:
+def flights(request: pytest.FixtureRequest) -> dict[FlightSpec, FlightResult | Exception]:
     """Every selected flight of this module, flown together."""
     wanted = [item.callspec.params["spec"] for item in request.session.items
               if item.module is request.module and hasattr(item, "callspec")]
@@ -82,9 +82,11 @@ def _problems(r: FlightResult) -> list[str]:
 
 
 @pytest.mark.parametrize("spec", MATRIX, ids=[s.id for s in MATRIX])
-def test_station_survives_the_fault(spec: FlightSpec,
-                                    flights: dict[FlightSpec, FlightResult]) -> None:
+def test_station_survives_the_fault(
+        spec: FlightSpec, flights: dict[FlightSpec, FlightResult | Exception]) -> None:
     r = flights[spec]
+    if isinstance(r, Exception):
+        raise r
     print(r.report())  # the numbers, kept for -rP / the log even when the case passes
     assert CASES[spec.case] is r.case
     problems = _problems(r)
