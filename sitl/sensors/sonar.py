@@ -3,9 +3,11 @@
 Each ping measures the slant range along body +z to the first surface (floor or box top). The
 reading is delivered when its echo would be back (2·d / 340 m/s later); the sensor does not ping
 again until then, like the real one, which blocks on its echo pin. No echo (beyond 4 m, or lost)
-ends the pulse after the ~38 ms timeout and gives an invalid reading; closer than 2 cm it reads
-invalid (distance 0). Over carpet (thesis Ch. 7) some echoes come back late, up to 1.2 s, still
-carrying the range of their ping, and some never return.
+ends the pulse after the ~38 ms timeout and gives an invalid reading; a surface closer than
+2 cm gives no reading at all (its echo comes back while the transducer still rings from the
+burst), so on the floor the sonar reads invalid (distance 0) whatever its noise, as the real
+firmwares report 0 on the ground. Over carpet (thesis Ch. 7) some echoes come back late, up to
+1.2 s, still carrying the range of their ping, and some never return.
 """
 
 from __future__ import annotations
@@ -65,7 +67,8 @@ class SonarModel:
                         reading = rng.uniform(prm.min_m, prm.max_m)
                     else:
                         reading += prm.noise_m * rng.standard_normal()
-            if valid and not prm.min_m <= reading <= prm.max_m:
+            # the true range decides below the minimum: noise cannot lift a reading into range
+            if valid and (range_m < prm.min_m or not prm.min_m <= reading <= prm.max_m):
                 reading, valid = 0.0, False
         self._in_flight = SonarSample(t_s=arrival, distance_m=reading, valid=valid, ping_t_s=t_s)
         self.next_ping_t_s = max(t_s + 1.0 / prm.rate_hz, arrival)
