@@ -23,6 +23,7 @@ call blocks its caller except `stop()` and `wait_until()`.
     proxy.drop("down", 15.0)           # the downlink dies now, for 15 simulated seconds
     proxy.set("both", loss=0.3, bitflip=0.05)
     proxy.counters("down").frames_dropped
+    FaultProxy(..., tap=fn)            # fn(direction, fate, frame, arrival) for every frame
     proxy.stop()
 
 `python -m sitl.fault_proxy --help` runs it from a shell (`sitl.fault_proxy_cli`).
@@ -61,6 +62,9 @@ from sitl.fault_lanes import (
 )
 
 MAX_WAIT_S = 0.05
+Tap = Callable[[Direction, str, bytes, float], None]
+"""Sees every frame: its direction, fate ("passed", "dropped", "corrupted"; the frame as it
+arrived), and the `time.monotonic()` of its arrival. Runs on the relay thread: keep it cheap."""
 SERIAL_BITS_PER_BYTE = 10  # 8N1
 
 
@@ -83,13 +87,14 @@ class FaultProxy:
     def __init__(self, target: tuple[str, int] | None = None, *, serial_port: str | None = None,
                  listen: tuple[str, int] = ("127.0.0.1", 0), seed: int | None = 0,
                  time_scale: float = 1.0, baud: int = 115200,
-                 connect_timeout_s: float = 2.0) -> None:
+                 connect_timeout_s: float = 2.0, tap: Tap | None = None) -> None:
         if (target is None) == (serial_port is None):
             raise ValueError("give exactly one of target (TCP) and serial_port")
         if not time_scale > 0.0:
             raise ValueError(f"time_scale must be > 0, got {time_scale}")
         self.target = target
         self.serial_port = serial_port
+        self.tap = tap
         self.time_scale = time_scale
         self.baud = baud
         self.connect_timeout_s = connect_timeout_s
@@ -317,6 +322,7 @@ class FaultProxy:
         d = lane.direction
         rng = self._rng[d]
         kept = bytearray()
+        fates: list[tuple[str, bytes]] = []
         with self._cond:
             if d is Direction.UP and self._station_t_s is None:
                 self._station_t_s = (wall - self._t0) * self.time_scale
@@ -338,15 +344,21 @@ class FaultProxy:
                 if dropping or u_loss < eff.loss:
                     dropped += 1
                     gone += len(chunk)
+                    fates.append(("dropped", chunk))
                 elif u_flip < eff.bitflip:
                     corrupted += 1
                     kept += flip_one_bit(chunk, float(u_bit))
+                    fates.append(("corrupted", chunk))
                 else:
                     passed += 1
                     kept += chunk
+                    fates.append(("passed", chunk))
             self._counts[d] = Counters(passed, dropped, corrupted, other, gone,
                                        c.bytes_in + len(data), c.bytes_out + len(kept))
             self._cond.notify_all()
+        if self.tap is not None:
+            for fate, frame in fates:
+                self.tap(d, fate, frame, wall)
         if kept:
             # FIFO even when the delay shrinks: a link delays, it does not reorder
             release = max(wall + eff.delay_s / self.time_scale, lane.last_release)

@@ -154,6 +154,8 @@ def test_loss_rate_is_within_tolerance_and_repeats_with_the_seed() -> None:
     n = 4000
     for _ in range(2):
         rig = TcpRig(seed=7)
+        fates: list[tuple[Direction, str]] = []
+        rig.proxy.tap = lambda d, fate, _frame, _t, seen=fates: seen.append((d, fate))
         try:
             rig.proxy.set("down", loss=0.3)
             rig.vehicle.sendall(b"".join(frames(n)))
@@ -164,6 +166,7 @@ def test_loss_rate_is_within_tolerance_and_repeats_with_the_seed() -> None:
             assert len(got) == c.frames_passed
             # binomial sigma is 0.7 % at 4000 frames: 3 % is over 4 sigma
             assert abs(c.frames_dropped / n - 0.3) < 0.03
+            assert fates.count((Direction.DOWN, "dropped")) == c.frames_dropped  # the tap saw all
             counts.append(c.frames_dropped)
         finally:
             rig.close()
