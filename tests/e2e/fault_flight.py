@@ -17,7 +17,6 @@ import contextlib
 import functools
 import json
 import os
-import select
 import socket
 import subprocess
 import sys
@@ -29,10 +28,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 from sitl.fault_frames import Counters, Direction
 from sitl.fault_proxy import FaultProxy
+from tests.e2e.fault_watch import MavWatcher, OverrideTap, SimClockMap
 
 ROOT = Path(__file__).resolve().parents[2]
 REST_ALT_M = 0.06  # the station's floor reference: its altitude of a vehicle standing on the floor
@@ -40,7 +39,6 @@ SETPOINT_M = 1.0
 FAULT_AFTER_HOLD_S = 30.0
 MODE_LAND = 9
 FLOOR_BAND_M = 0.03  # within this of the resting altitude: on the floor
-OBSERVER_SYSID = 254  # not SYSID_MYGCS: its requests never count as the GCS being alive
 # Sped up, the serial line keeps its baud rate in simulated time, so it gets the smaller factor
 # (as the alt-hold e2e tests fly it).
 TCP_SPEEDUP, SERIAL_SPEEDUP = 4.0, 2.0
@@ -99,6 +97,7 @@ class FlightResult:
     up: Counters
     down: Counters
     wall_s: float
+    overrides: list[tuple[float, int]]  # (sim t, throttle us) of every override that got through
 
     # ------------------------------------------------------------ derived numbers
     @property
@@ -202,6 +201,19 @@ class FlightResult:
         sel = (self.t_s >= self.fault_start_s) & (self.t_s <= self.fault_end_s)
         return float(np.max(np.abs(self.alt_m[sel] - SETPOINT_M))) if sel.any() else None
 
+    @property
+    def last_throttle_us(self) -> tuple[int, float, float] | None:
+        """(the last throttle the vehicle received before the fault, the median and the
+        half-width of the 5-95 % band of the 10 s before): what it flies open-loop on."""
+        if self.fault_start_s is None:
+            return None
+        t0 = self.fault_start_s
+        before = [thr for t, thr in self.overrides if t0 - 10.0 <= t < t0]
+        if not before:
+            return None
+        lo, mid, hi = np.percentile(before, (5, 50, 95))
+        return before[-1], float(mid), float(hi - lo) / 2.0
+
     def report(self) -> str:
         """The run in a few lines, for assertion messages and the bench."""
         def f(x: float | None, unit: str) -> str:
@@ -220,88 +232,11 @@ class FlightResult:
                 f" after; LAND seen {f(rel(self.land_mode_s), ' s')} after; failsafe texts "
                 f"{[(round(t - (t0 or 0), 1), s) for t, s in self.failsafe_texts]}; open-loop "
                 f"{f(self.open_loop_s, ' s')}, drift {drift and tuple(round(d, 3) for d in drift)}"
+                f"; last throttle before the fault (us, hold median, ±5-95 %) "
+                f"{self.last_throttle_us}"
                 f"; hold dev in fault {f(self.hold_during_fault_m, ' m')}; params "
                 f"{self.params}; proxy up [{self.up.line()}] down [{self.down.line()}]; "
                 f"{self.wall_s:.0f} s wall")
-
-
-# ------------------------------------------------------------------ watchers
-class MavWatcher:
-    """Reads MAVLink from a socket on its own thread and keeps what the suite needs."""
-
-    def __init__(self, sock: socket.socket, udp: bool) -> None:
-        self.sock = sock
-        self.udp = udp
-        self.mocap: list[tuple[float, float, float]] = []  # (wall, sim t, up m)
-        self.heartbeats: list[tuple[float, bool, int]] = []  # (wall, armed, mode)
-        self.texts: list[tuple[float, str]] = []
-        self.params: dict[str, float] = {}
-        self.peer: tuple[str, int] | None = None
-        self._mav = mavlink.MAVLink(None, srcSystem=OBSERVER_SYSID, srcComponent=191)
-        self._mav.robust_parsing = True
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True, name="mav-watch")
-        self._thread.start()
-
-    def _run(self) -> None:
-        while not self._stop.is_set():
-            r, _, _ = select.select([self.sock], [], [], 0.05)
-            if not r:
-                continue
-            try:
-                data, addr = self.sock.recvfrom(65536)
-            except OSError:
-                return
-            if not data:
-                return
-            self.peer = addr if self.udp else self.peer
-            wall = time.monotonic()
-            for m in self._mav.parse_buffer(data) or []:
-                self._keep(m, wall)
-
-    def _keep(self, m: Any, wall: float) -> None:
-        kind = m.get_type()
-        if kind == "ATT_POS_MOCAP":
-            self.mocap.append((wall, m.time_usec * 1e-6, -m.z))
-        elif kind == "HEARTBEAT" and m.get_srcComponent() == 1:
-            self.heartbeats.append((wall, bool(m.base_mode & 128), int(m.custom_mode)))
-        elif kind == "STATUSTEXT":
-            self.texts.append((wall, m.text))
-        elif kind == "PARAM_VALUE":
-            self.params[m.param_id] = float(m.param_value)
-
-    def request_params(self, names: tuple[str, ...], timeout_s: float) -> dict[str, float]:
-        """Read parameters over this (UDP) endpoint, as an observer that is not the GCS."""
-        deadline = time.monotonic() + timeout_s
-        while self.peer is not None and time.monotonic() < deadline:
-            missing = [n for n in names if n not in self.params]
-            if not missing:
-                break
-            for n in missing:
-                msg = mavlink.MAVLink_param_request_read_message(1, 1, n.encode(), -1)
-                self.sock.sendto(msg.pack(self._mav), self.peer)
-            end = time.monotonic() + 0.3
-            while time.monotonic() < end and any(n not in self.params for n in missing):
-                time.sleep(0.02)  # the reader thread fills self.params
-        return {n: self.params[n] for n in names if n in self.params}
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(2.0)
-        self.sock.close()
-
-
-class SimClockMap:
-    """Wall time → simulated time, from the mocap stream's (arrival, time_usec) pairs."""
-
-    def __init__(self, mocap: list[tuple[float, float, float]]) -> None:
-        arr = np.array(mocap, dtype=float).reshape(-1, 3)
-        self.wall, self.sim = arr[:, 0], arr[:, 1]
-
-    def __call__(self, wall: float) -> float:
-        if self.wall.size == 0:
-            return float("nan")
-        return float(np.interp(wall, self.wall, self.sim))
 
 
 # ------------------------------------------------------------------ the run
@@ -360,13 +295,14 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
         host, port = mocap_url.removeprefix("tcp:").rsplit(":", 1)
         watch_mocap = MavWatcher(socket.create_connection((host, int(port)), 5.0), udp=False)
         stack.callback(watch_mocap.close)
+        tap = OverrideTap()
         if transport == "serial":
             proxy = FaultProxy(serial_port=sitl.endpoint(1, "serial"), seed=seed,
-                               time_scale=speedup)
+                               time_scale=speedup, tap=tap)
             connect = f"{proxy.address},115200"
         else:
             h, p = sitl.endpoint(1, "tcp").rsplit(":", 1)
-            proxy = FaultProxy(target=(h, int(p)), seed=seed, time_scale=speedup)
+            proxy = FaultProxy(target=(h, int(p)), seed=seed, time_scale=speedup, tap=tap)
             connect = proxy.address
         proxy.start()
         stack.callback(proxy.stop)
@@ -403,7 +339,8 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
             heartbeats=[(clock(w), a, m) for w, a, m in watch_udp.heartbeats],
             texts=[(clock(w), s) for w, s in watch_udp.texts],
             params=params, up=proxy.counters("up"), down=proxy.counters("down"),
-            wall_s=time.monotonic() - wall0)
+            wall_s=time.monotonic() - wall0,
+            overrides=[(clock(w), thr) for w, thr in tap.throttle])
 
 
 def _disarmed_after(w: MavWatcher, wall: float) -> bool:

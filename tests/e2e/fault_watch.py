@@ -1,0 +1,113 @@
+"""What the fault suite watches from outside the link it breaks: motion capture and a
+listen-only UDP endpoint of the SITL (`MavWatcher`), the overrides that reached the vehicle (a
+fault-proxy tap), and the map from wall-clock stamps to the SITL's simulated time."""
+
+from __future__ import annotations
+
+import contextlib
+import select
+import socket
+import threading
+import time
+from typing import Any
+
+import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+from sitl.fault_frames import Direction
+
+OBSERVER_SYSID = 254  # not SYSID_MYGCS: its requests never count as the GCS being alive
+RC_OVERRIDE_ID = mavlink.MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE
+
+
+class MavWatcher:
+    """Reads MAVLink from a socket on its own thread and keeps what the suite needs."""
+
+    def __init__(self, sock: socket.socket, udp: bool) -> None:
+        self.sock = sock
+        self.udp = udp
+        self.mocap: list[tuple[float, float, float]] = []  # (wall, sim t, up m)
+        self.heartbeats: list[tuple[float, bool, int]] = []  # (wall, armed, mode)
+        self.texts: list[tuple[float, str]] = []
+        self.params: dict[str, float] = {}
+        self.peer: tuple[str, int] | None = None
+        self._mav = mavlink.MAVLink(None, srcSystem=OBSERVER_SYSID, srcComponent=191)
+        self._mav.robust_parsing = True
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True, name="mav-watch")
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            r, _, _ = select.select([self.sock], [], [], 0.05)
+            if not r:
+                continue
+            try:
+                data, addr = self.sock.recvfrom(65536)
+            except OSError:
+                return
+            if not data:
+                return
+            self.peer = addr if self.udp else self.peer
+            wall = time.monotonic()
+            for m in self._mav.parse_buffer(data) or []:
+                self._keep(m, wall)
+
+    def _keep(self, m: Any, wall: float) -> None:
+        kind = m.get_type()
+        if kind == "ATT_POS_MOCAP":
+            self.mocap.append((wall, m.time_usec * 1e-6, -m.z))
+        elif kind == "HEARTBEAT" and m.get_srcComponent() == 1:
+            self.heartbeats.append((wall, bool(m.base_mode & 128), int(m.custom_mode)))
+        elif kind == "STATUSTEXT":
+            self.texts.append((wall, m.text))
+        elif kind == "PARAM_VALUE":
+            self.params[m.param_id] = float(m.param_value)
+
+    def request_params(self, names: tuple[str, ...], timeout_s: float) -> dict[str, float]:
+        """Read parameters over this (UDP) endpoint, as an observer that is not the GCS."""
+        deadline = time.monotonic() + timeout_s
+        while self.peer is not None and time.monotonic() < deadline:
+            missing = [n for n in names if n not in self.params]
+            if not missing:
+                break
+            for n in missing:
+                msg = mavlink.MAVLink_param_request_read_message(1, 1, n.encode(), -1)
+                self.sock.sendto(msg.pack(self._mav), self.peer)
+            end = time.monotonic() + 0.3
+            while time.monotonic() < end and any(n not in self.params for n in missing):
+                time.sleep(0.02)  # the reader thread fills self.params
+        return {n: self.params[n] for n in names if n in self.params}
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(2.0)
+        self.sock.close()
+
+
+class OverrideTap:
+    """The proxy's tap: the throttle of every RC_CHANNELS_OVERRIDE that reached the vehicle."""
+
+    def __init__(self) -> None:
+        self.throttle: list[tuple[float, int]] = []  # (wall, chan3 us)
+        self._mav = mavlink.MAVLink(None)
+
+    def __call__(self, d: Direction, fate: str, frame: bytes, wall: float) -> None:
+        msg_id = frame[5] if frame[0] == 0xFE else frame[7] | frame[8] << 8 | frame[9] << 16
+        if d is not Direction.UP or fate != "passed" or msg_id != RC_OVERRIDE_ID:
+            return
+        with contextlib.suppress(Exception):  # a frame it cannot decode is no override
+            self.throttle.append((wall, int(self._mav.decode(bytearray(frame)).chan3_raw)))
+
+
+class SimClockMap:
+    """Wall time → simulated time, from the mocap stream's (arrival, time_usec) pairs."""
+
+    def __init__(self, mocap: list[tuple[float, float, float]]) -> None:
+        arr = np.array(mocap, dtype=float).reshape(-1, 3)
+        self.wall, self.sim = arr[:, 0], arr[:, 1]
+
+    def __call__(self, wall: float) -> float:
+        if self.wall.size == 0:
+            return float("nan")
+        return float(np.interp(wall, self.wall, self.sim))
