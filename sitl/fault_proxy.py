@@ -115,10 +115,10 @@ class FaultProxy:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._t0 = time.monotonic()
-        self.connections = 0
+        self.connections = 0  # TCP stations accepted so far
         self.refused = 0  # stations turned away because the vehicle endpoint did not answer
         self.error: BaseException | None = None
-        self.port = 0
+        self.host, self.port = "", 0
         self.serial_path: str | None = None
         try:
             if target is not None:
@@ -136,7 +136,7 @@ class FaultProxy:
         self._listener.bind(listen)
         self._listener.listen(4)
         self._listener.setblocking(False)
-        self.port = self._listener.getsockname()[1]
+        self.host, self.port = self._listener.getsockname()[:2]
 
     def _open_serial(self, path: str) -> None:
         self._serial = serial.Serial(path, self.baud, timeout=0, write_timeout=0)
@@ -153,7 +153,6 @@ class FaultProxy:
             up=Lane(Direction.UP, fd_reader(master), master, fd_writer(vfd), vfd, rate),
             down=Lane(Direction.DOWN, fd_reader(vfd), vfd, fd_writer(master), master, rate),
             close=lambda: None))
-        self.connections = 1
 
     def start(self) -> FaultProxy:
         """Start relaying on the proxy's thread; the proxy's clock starts now."""
@@ -188,8 +187,8 @@ class FaultProxy:
 
     @property
     def address(self) -> str:
-        """What a station connects to: `tcp:127.0.0.1:PORT`, or the pseudo-terminal's path."""
-        return self.serial_path if self.serial_path is not None else f"tcp:127.0.0.1:{self.port}"
+        """What a station connects to: `tcp:HOST:PORT`, or the pseudo-terminal's path."""
+        return self.serial_path if self.serial_path is not None else f"tcp:{self.host}:{self.port}"
 
     def _close_all(self) -> None:
         with self._cond:
