@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import ipaddress
 import json
 import math
 import signal
+import socket
 import sys
 from typing import Any
 
+from firmware_link import LinkError, parse_connection_string
 from firmware_link.records import Dialect
 from gcs.clock import Clock
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
@@ -33,7 +36,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--step", type=float, default=0.0,
                    help="after the hold, step the setpoint by this many m and score it")
     p.add_argument("--speedup", type=float, default=1.0,
-                   help="run the bundled SITL and the loop this many times faster (default 1)")
+                   help="run the bundled SITL and the loop this many times faster (default 1); "
+                        "with --connect only for a simulator on this machine started with the "
+                        "same speed-up")
     p.add_argument("--takeoff-delay", type=float, default=0.0, metavar="S",
                    help="stay armed on the floor this long before taking off (default 0)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -143,6 +148,21 @@ def _print_summary(d: dict[str, Any]) -> None:
     print(f"recording: {d['recording'] or 'off'}")
 
 
+def _simulator_url(url: str) -> bool:
+    """A connection that can only reach a program on this machine (loopback, a pty): the only
+    kind a sped-up clock may fly, since a real vehicle answers in real time."""
+    try:
+        spec = parse_connection_string(url)
+    except LinkError:
+        return False
+    if spec.device:
+        return spec.device.startswith("/dev/pts/")
+    try:
+        return ipaddress.ip_address(socket.gethostbyname(spec.host)).is_loopback
+    except (OSError, ValueError):
+        return False
+
+
 def _on_sigterm(signum: int, frame: object) -> None:
     # a terminated flight unwinds like Ctrl-C: the session lands the vehicle before letting go
     raise KeyboardInterrupt(f"signal {signum}")
@@ -152,9 +172,9 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
     """Run the whole flight; return the summary dict (the CLI prints it). FlightFailed (exit 3)
     when the flight did not go as commanded; leaving the session lands a flying vehicle."""
     plan = _plan(args)
-    if args.speedup != 1.0 and args.connect is not None:
-        raise UsageError("--speedup applies to the bundled SITL only; a vehicle at --connect "
-                         "flies in real time")
+    if args.speedup != 1.0 and args.connect is not None and not _simulator_url(args.connect):
+        raise UsageError("--speedup applies to a simulator on this machine only (loopback or a "
+                         "pseudo-terminal); a vehicle at --connect flies in real time")
     options = session_options(args, "fly")
     with contextlib.suppress(ValueError):  # not the main thread (tests): no handler needed
         signal.signal(signal.SIGTERM, _on_sigterm)

@@ -401,8 +401,10 @@ class Supervisor:
         airborne = (est.alt_m > self.rest_alt_m + p.liftoff_rise_m
                     and est.vel_mps > p.liftoff_vel_mps)
         if airborne:
+            # Off the floor, the hover throttle holds it (no more ground effect to overcome);
+            # the ramp's own value, accelerating the vehicle, would carry into an overshoot.
             back = p.ramp_rate_us_per_s * p.liftoff_lag_s
-            self._engage(inp, max(STICK_MIN_US, self._ramp_us - back),
+            self._engage(inp, max(STICK_MIN_US, min(hover, self._ramp_us - back)),
                          f"left the floor at {round(self._ramp_us)} us: altitude hold on")
             return self._hold(inp)
         top = min(STICK_MAX_US, hover + p.ramp_above_hover_us)
