@@ -7,11 +7,12 @@ that tell the families apart (`firmware.PROBE_PARAMS`). It stops as soon as the 
 the family and the GCS-id parameter's name: an existing name answers at once, a missing one
 never does, so waiting out the deadline is only for a vehicle that says nothing.
 
-When no version number came, the version banner is asked for with PARAM_REQUEST_LIST, which is
-how ArduCopter 3.2.1 sends "ArduCopter V3.2.1": the banner comes before the first parameter, so
-the wait ends shortly after the list starts. The parameter list then runs on in the background
-(≈ 16 s at 3.2.1's pace, a few per cent of a 115200-baud link), as it does for every ground
-station that connects.
+The version banner is not asked for by default: PARAM_REQUEST_LIST is the only way to make
+ArduCopter 3.2.1 send "ArduCopter V3.2.1", and 3.2.1 sends nothing else while its list runs
+(≈ 16 s at about 25 parameters a second; "don't send anything else at the same time as
+parameters" in its GCS code), so asking at connect would silence the telemetry a flight needs.
+A 4.x answers AUTOPILOT_VERSION instead. `identify(ask_banner=True)` asks (on the ground only),
+and any banner heard anyway (at boot, or during `fetch_params`) is evidence for the next call.
 """
 
 from __future__ import annotations
@@ -49,17 +50,19 @@ class Identification:
     _target_component: int
     _evidence: FirmwareEvidence
     _firmware: FirmwareInfo
+    _armed: bool
     _send: Callable[[Any], bool]
     _command_long: Callable[..., bool]
     _step: Callable[[float], list[Any]]
     _request_read: Callable[[str], bool]
     _event: Callable[[float, LinkEventKind, str], None]
 
-    def identify(self, timeout_s: float = 1.5, *, ask_banner: bool = True) -> FirmwareInfo:
+    def identify(self, timeout_s: float = 1.5, *, ask_banner: bool = False) -> FirmwareInfo:
         """Find out the firmware from what the vehicle says; the result is also `firmware`.
 
         Never fails for want of evidence: with none, the verdict rests on the wire version
-        and its `evidence` says so.
+        and its `evidence` says so. `ask_banner` requests the version banner when no version
+        number came (see the module docstring for its cost); it is not done while armed.
         """
         ev = self._evidence
         start = self._clock()
@@ -93,7 +96,7 @@ class Identification:
         if ev.sw_version is None:
             ev.version_refused = True
         ev.params_missing |= {n for n in probes if n not in ev.params_seen}
-        if ask_banner and ev.sw_version is None and not ev.banner:
+        if ask_banner and ev.sw_version is None and not ev.banner and not self._armed:
             self._ask_banner()
         self._firmware = info = decide_firmware(ev)
         self._ep.wire = info.wire

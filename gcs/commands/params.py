@@ -200,7 +200,9 @@ def _set(link: VehicleLink, name: str, value: float) -> int:
 
 def _save(link: VehicleLink, path: Path) -> int:
     params = link.fetch_params()
-    fw = link.firmware
+    # The list brought the version banner (3.2.1 gives its version no other way): the
+    # header names the firmware exactly.
+    fw = link.identify()
     stamp = dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
     header = [fw.summary, f"vehicle {link.target_system}, {len(params)} parameters, {stamp}"]
     types = {n: t for n in params if (t := link.param_type(n)) is not None}

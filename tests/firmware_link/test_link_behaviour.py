@@ -129,14 +129,30 @@ def test_identifies_3_2_1_by_parameters_and_banner(serial: bool) -> None:
         with VehicleLink.open(v.url) as link:
             fw = link.firmware
             assert fw.dialect is Dialect.APM25 and link.dialect is Dialect.APM25
-            assert fw.version == "ArduCopter V3.2.1"
+            assert fw.version == "" and fw.name == "ArduCopter 3.x"
             assert fw.gcs_sysid_param == "SYSID_MYGCS" and fw.wire is WireVersion.V1
             joined = " | ".join(fw.evidence)
             assert "AUTOPILOT_VERSION not answered" in joined and "THR_MID exists" in joined
             (event,) = events(link.poll(), LinkEventKind.DIALECT)
-            assert event.detail.startswith("ArduCopter V3.2.1: dialect APM25")
+            assert event.detail.startswith("ArduCopter 3.x (no version given): dialect APM25")
+            # 3.2.1 sends nothing else while its parameter list runs: not asked at connect
+            assert "PARAM_REQUEST_LIST" not in v.state.rx_types
+            link.arm()
+            assert link.identify(ask_banner=True).version == ""  # never while armed
+            assert "PARAM_REQUEST_LIST" not in v.state.rx_types
+            link.disarm()
+            fw = link.identify(ask_banner=True)
+            assert fw.version == "ArduCopter V3.2.1" and fw.version_number == (3, 2, 1)
+            assert any("banner 'ArduCopter V3.2.1'" in e for e in fw.evidence)
     finally:
         v.stop()
+
+
+def test_a_parameter_download_brings_the_banner_for_the_next_identify(apm25: FakeVehicle) -> None:
+    with VehicleLink.open(apm25.url) as link:
+        assert link.firmware.version == ""
+        link.fetch_params()
+        assert link.identify().version == "ArduCopter V3.2.1"
 
 
 def test_identifies_4_7_by_autopilot_version() -> None:
