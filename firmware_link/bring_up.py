@@ -18,6 +18,7 @@ from firmware_link.streams import (
     BringUpReport,
     BringUpStep,
     StreamPlan,
+    apm25_delivered_hz,
     bring_up_periods_ms,
     fast_rate_limit_hz,
     measured_rate_hz,
@@ -98,24 +99,29 @@ class StreamBringUp:
             finally:
                 self._rate_probe = None
             elapsed = max(self._clock() - t_before, 1e-9)
+            asked = rates.get("ATTITUDE", 0.0)
             step = BringUpStep(
                 period_ms=period,
-                requested_hz=rates.get("ATTITUDE", 0.0),
+                requested_hz=asked,
                 measured_hz=measured_rate_hz(measured.get("ATTITUDE", []), window),
                 rx_bytes_per_s=(self._ep.tally.rx_bytes - bytes_before) / elapsed,
+                expected_hz=apm25_delivered_hz(asked) if whole_hz else None,
             )
             steps.append(step)
             # Estimate only once the fast streams clearly outrun the slow ones (their rates
             # tell them apart), and trust the latest, fastest step most.
             last_step = k == len(periods) - 1
-            if not last_step and budget is not None and step.requested_hz >= 1.5 * slowest_fast_hz:
+            # The fast streams run at what the firmware delivers (3.2.1 rounds to 50/N Hz), so
+            # they are told and scaled by the measured rate, not the one asked.
+            fast_hz = step.measured_hz if step.measured_hz > 0 else step.requested_hz
+            if not last_step and budget is not None and fast_hz >= 1.5 * slowest_fast_hz:
                 fast_bytes = sum(
                     self._byte_probe.get(kind, 0)
                     for kind, stamps in measured.items()
-                    if len(stamps) / elapsed >= 0.75 * step.requested_hz
+                    if len(stamps) / elapsed >= 0.75 * fast_hz
                 )
                 limit_hz = fast_rate_limit_hz(
-                    step.rx_bytes_per_s, fast_bytes / elapsed, step.requested_hz, budget
+                    step.rx_bytes_per_s, fast_bytes / elapsed, fast_hz, budget
                 )
         achieved = tuple(
             (r.message, measured_rate_hz(measured.get(r.message, []), final_window_s))
@@ -124,7 +130,7 @@ class StreamBringUp:
         last = steps[-1]
         final_hz = last.measured_hz
         reached = abs(final_hz - target_rate_hz) <= tolerance * target_rate_hz
-        confirmed = abs(final_hz - last.requested_hz) <= tolerance * last.requested_hz
+        confirmed = last.delivered(tolerance)
         limited = limit_hz < target_rate_hz
         if capacity is None:
             carried = f"{last.rx_bytes_per_s:.0f} B/s carried (network link)"
@@ -136,7 +142,10 @@ class StreamBringUp:
         self._event(
             self._clock(),
             LinkEventKind.STREAMS,
-            f"ATTITUDE {final_hz:.1f} Hz of {last.requested_hz:.1f} Hz asked; {carried}"
+            f"ATTITUDE {final_hz:.1f} Hz of {last.requested_hz:.1f} Hz asked"
+            + ("" if last.expected_hz is None else
+               f" (the firmware gives {last.expected[0]:.1f}..{last.expected[1]:.1f} Hz)")
+            + f"; {carried}"
             + (f"; link budget limits fast streams to {limit_hz:.1f} Hz" if limited else ""),
         )
         return BringUpReport(

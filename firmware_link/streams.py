@@ -203,6 +203,25 @@ def wanted_streams(dialect: Dialect, target_rate_hz: float = 40.0) -> tuple[Stre
     )
 
 
+APM25_LOOP_HZ = 50.0  # ArduCopter 3.2.1 runs its stream loop (gcs_data_stream_send) at 50 Hz
+
+
+def apm25_delivered_hz(requested_hz: float) -> tuple[float, float]:
+    """The slowest and fastest rate ArduCopter 3.2.1 delivers for a REQUEST_DATA_STREAM rate.
+
+    Its stream loop triggers a group every int(50 / rate) + stream_slowdown ticks
+    (`stream_trigger`: ticks = 50 / rate - 1 + stream_slowdown, truncated to a uint8), and
+    stream_slowdown is 0 or 1 by how full the port is. So a rate r arrives at 50 / N Hz:
+    25 Hz asked gives 25 or 16.7 Hz (16.4 measured on the real firmware), 40 Hz gives 50 or
+    25 Hz, never 40.
+    """
+    rate = min(APM25_LOOP_HZ, float(int(requested_hz)))
+    if rate <= 0:
+        return 0.0, 0.0
+    ticks = int(APM25_LOOP_HZ / rate)
+    return APM25_LOOP_HZ / (ticks + 1), APM25_LOOP_HZ / ticks
+
+
 def bring_up_periods_ms(
     start_ms: float = 100.0, end_ms: float = 25.0, steps: int = 5
 ) -> tuple[float, ...]:
@@ -253,6 +272,18 @@ class BringUpStep:
     requested_hz: float
     measured_hz: float
     rx_bytes_per_s: float = 0.0  # everything the link carried during the window
+    # what the firmware delivers for the rate asked: (slowest, fastest); 3.2.1 rounds to 50/N Hz
+    expected_hz: tuple[float, float] | None = None
+
+    @property
+    def expected(self) -> tuple[float, float]:
+        """(slowest, fastest) rate the firmware should deliver for `requested_hz`."""
+        return self.expected_hz or (self.requested_hz, self.requested_hz)
+
+    def delivered(self, tolerance: float = 0.1) -> bool:
+        """The measured rate is one the firmware delivers for the rate asked."""
+        low, high = self.expected
+        return low * (1.0 - tolerance) <= self.measured_hz <= high * (1.0 + tolerance)
 
 
 @dataclass(frozen=True, slots=True)
@@ -276,8 +307,11 @@ class BringUpReport:
         """Human-readable bring-up report: steps, budget, achieved rates."""
         lines = [f"link bring-up ({self.dialect.value}):"]
         for s in self.steps:
+            low, high = s.expected
+            exact = low == high == s.requested_hz
+            gives = "" if exact else f" (gives {low:.1f}..{high:.1f})"
             lines.append(
-                f"  step {s.period_ms:5.1f} ms: ATTITUDE asked {s.requested_hz:5.1f} Hz, "
+                f"  step {s.period_ms:5.1f} ms: ATTITUDE asked {s.requested_hz:5.1f} Hz{gives}, "
                 f"got {s.measured_hz:5.1f} Hz; link carried {s.rx_bytes_per_s:6.0f} B/s"
             )
         lines.extend("  " + line for line in self.plan.budget_lines())
@@ -289,6 +323,12 @@ class BringUpReport:
             lines.append(f"  link budget measured: fast streams limited to {self.limit_hz:.1f} Hz")
         if self.reached:
             lines.append("  target reached")
+        elif self.dialect is Dialect.APM25 and self.confirmed:
+            low, high = self.steps[-1].expected
+            lines.append(
+                f"  target NOT reached: ArduCopter 3.2.1 sends {self.target_rate_hz:.0f} Hz as "
+                f"{low:.1f} or {high:.1f} Hz (50/N); rate asked confirmed"
+            )
         else:
             asked = "confirmed" if self.confirmed else "NOT confirmed"
             lines.append(f"  target NOT reached; rate asked {asked}")

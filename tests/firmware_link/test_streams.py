@@ -153,3 +153,15 @@ def test_a_plan_never_exceeds_its_budget_nor_leaves_min_max(capacity, picks, gro
         group_min = max(x.min_rate_hz for x in members)
         group_max = max(x.rate_hz for x in members)
         assert group_min - 1e-9 <= rate <= group_max + 1e-9
+
+
+def test_apm25_delivers_50_over_n_hz() -> None:
+    from firmware_link.streams import BringUpStep, apm25_delivered_hz
+
+    assert apm25_delivered_hz(25) == (50 / 3, 25.0)  # 16.4 Hz measured on the real 3.2.1
+    assert apm25_delivered_hz(40) == (25.0, 50.0)  # never 40
+    assert apm25_delivered_hz(10) == (50 / 6, 10.0)
+    assert apm25_delivered_hz(80) == (25.0, 50.0)  # capped at the 50 Hz loop
+    assert apm25_delivered_hz(0.5) == (0.0, 0.0)  # a uint8 rate of 0: off
+    step = BringUpStep(25.0, 40.0, 25.1, expected_hz=apm25_delivered_hz(40))
+    assert step.delivered() and not BringUpStep(25.0, 40.0, 25.1).delivered()
