@@ -332,3 +332,20 @@ def test_copter4_older_than_47_takes_overrides_from_sysid_mygcs() -> None:
     other = MemoryGcs(sim, sim.memory_link(1), False, sysid=254)
     other.override(1, 1500, 1500, 1700, 1500)
     assert gcs.of_type("RC_CHANNELS", gcs.run(0.3))[-1].chan3_raw == 1700
+
+
+def test_command_line_options_reach_the_autopilot(capsys: pytest.CaptureFixture[str]) -> None:
+    from sitl import cli
+
+    args = cli.build_parser().parse_args(
+        ["--tcp", "0", "--profile", "copter4", "--realistic-boot", "--copter4-version", "4.6"]
+    )
+    server = cli._server_from_args(args)
+    try:
+        ap = server.sim.vehicle(1).autopilot
+        assert ap.options == AutopilotOptions(realistic_boot=True, copter4_version="4.6")
+        assert "SYSID_MYGCS" in server.sim.vehicle(1).params
+    finally:
+        server.close()
+    assert cli.main(["--tcp", "0", "--copter4-version", "4.6"]) == 2  # apm25 has no such thing
+    assert "--copter4-version: needs --profile copter4" in capsys.readouterr().err
