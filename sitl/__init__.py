@@ -1,6 +1,6 @@
 """The bundled simulated vehicle: physics, ArduCopter-like autopilot, sensors, MAVLink endpoints."""
 
-from sitl.autopilot import FlightMode, Profile
+from sitl.autopilot import AutopilotOptions, FlightMode, Profile
 from sitl.battery import BatteryState
 from sitl.params import ParamError, VehicleParams
 from sitl.physics import PhysicsState
@@ -27,6 +27,7 @@ from sitl.world import (
 )
 
 __all__ = [
+    "AutopilotOptions",
     "BaroSample",
     "BatteryState",
     "Box",
