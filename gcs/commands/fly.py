@@ -2,6 +2,10 @@
 
 With no `--connect` it starts the bundled SITL and flies that. `--json` prints one JSON object;
 `--live` prints a telemetry line a few times per second while flying.
+
+The pilot's switches at the terminal: Ctrl-C (or SIGTERM) ends the flight by landing the vehicle
+(LAND, confirmed) before letting go; Ctrl-\\ (SIGQUIT) is the kill switch: throttle minimum and
+disarm, repeated until the vehicle says it is disarmed.
 """
 
 from __future__ import annotations
@@ -176,10 +180,11 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError("--speedup applies to a simulator on this machine only (loopback or a "
                          "pseudo-terminal); a vehicle at --connect flies in real time")
     options = session_options(args, "fly")
-    with contextlib.suppress(ValueError):  # not the main thread (tests): no handler needed
-        signal.signal(signal.SIGTERM, _on_sigterm)
     with StationSession(options) as session:
         v = session.first
+        with contextlib.suppress(ValueError):  # not the main thread (tests): no handlers
+            signal.signal(signal.SIGTERM, _on_sigterm)
+            signal.signal(signal.SIGQUIT, lambda _n, _f: v.station.kill())
         v.station.start()
         printer = LivePrinter(session.clock) if args.live else None
         runner = FlightRunner(v.station, plan, printer)

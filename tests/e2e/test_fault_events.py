@@ -1,0 +1,221 @@
+"""What the pilot or the vehicle does mid-flight, with `quadgcs fly` over TCP to the SITL.
+
+The station is the real CLI through the fault proxy (so a fault can be added and every override
+that reached the vehicle is seen); height comes from motion capture, the vehicle's arming and
+mode from a listen-only UDP endpoint of the SITL. Cases:
+
+- the station is SIGKILLed mid-air: the vehicle's own failsafe (set up before the flight) lands it;
+- the vehicle auto-disarms on the floor before take-off: fly says so (exit 3), nothing winds up;
+- LAND comes from elsewhere mid-hold (a mode switch, another GCS): PC control ends, the throttle
+  goes to minimum, the vehicle lands and disarms, fly exits 3 naming it;
+- the pilot's kill switch (SIGQUIT) during a link loss, each way: throttle minimum from the next
+  tick, disarmed within a second of the uplink working.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pytest
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+from sitl.fault_frames import Direction
+from sitl.fault_proxy import FaultProxy
+from tests.e2e.fault_flight import FLOOR_BAND_M, REST_ALT_M, ROOT, SETPOINT_M, _sitl
+from tests.e2e.fault_watch import MavWatcher, OverrideTap, SimClockMap
+
+pytestmark = [pytest.mark.e2e, pytest.mark.timeout(300)]
+
+SPEEDUP = 4.0
+MODE_LAND = 9
+
+
+@dataclass
+class Run:
+    """One flight's observations; times in the SITL's simulated seconds."""
+
+    exit_code: int
+    stderr: str
+    t_s: np.ndarray
+    alt_m: np.ndarray
+    event_s: float | None  # when the case's event happened
+    heartbeats: list[tuple[float, bool, int]]
+    texts: list[tuple[float, str]]
+    overrides: list[tuple[float, int]]
+
+    @property
+    def reason(self) -> str:
+        lines = self.stderr.strip().splitlines()
+        return lines[-1] if lines else ""
+
+    def touchdown(self) -> tuple[float, float] | None:
+        """(time, speed just before contact) of the first floor contact after the event."""
+        assert self.event_s is not None
+        idx = np.nonzero((self.t_s >= self.event_s) & (self.alt_m <= REST_ALT_M + FLOOR_BAND_M))[0]
+        if not idx.size:
+            return None
+        t_c = float(self.t_s[idx[0]])
+        sel = (self.t_s >= t_c - 0.25) & (self.t_s <= t_c)
+        slope = np.polyfit(self.t_s[sel] - t_c, self.alt_m[sel], 1)[0] if sel.sum() >= 3 else 0.0
+        return t_c, float(max(0.0, -slope))
+
+    def disarmed_s(self) -> float | None:
+        """First sign of a disarm after the event: the vehicle's text, or a heartbeat (1 Hz)."""
+        assert self.event_s is not None
+        ts = [t for t, armed, _ in self.heartbeats if t >= self.event_s and not armed][:1]
+        ts += [t for t, text in self.texts if t >= self.event_s and "disarm" in text.lower()][:1]
+        return min(ts) if ts else None
+
+
+Trigger = Callable[[subprocess.Popen[str], FaultProxy, MavWatcher], None]
+
+
+@contextlib.contextmanager
+def _rig(profile: str) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy, OverrideTap]]:
+    udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    udp.bind(("127.0.0.1", 0))
+    args = ["--tcp", "0", "--profile", profile, "--speedup", f"{SPEEDUP:g}", "--seed", "4",
+            "--udp", f"127.0.0.1:{udp.getsockname()[1]}"]
+    with contextlib.ExitStack() as stack:
+        sitl = stack.enter_context(_sitl(args))
+        watch_udp = MavWatcher(udp, udp=True)
+        stack.callback(watch_udp.close)
+        mocap_url = next(line.split(" ", 1)[1] for line in sitl.lines if line.startswith("mocap "))
+        host, port = mocap_url.removeprefix("tcp:").rsplit(":", 1)
+        watch_mocap = MavWatcher(socket.create_connection((host, int(port)), 5.0), udp=False)
+        stack.callback(watch_mocap.close)
+        tap = OverrideTap()
+        h, p = sitl.endpoint(1, "tcp").rsplit(":", 1)
+        proxy = FaultProxy(target=(h, int(p)), seed=4, time_scale=SPEEDUP, tap=tap).start()
+        stack.callback(proxy.stop)
+        sitl.mocap_url = mocap_url
+        yield sitl, watch_udp, watch_mocap, proxy, tap
+
+
+def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float = 3.0,
+        extra: tuple[str, ...] = (), watch_s: float = 25.0) -> Run:
+    """Fly 1 m; `after_s` simulated seconds into `phase` (seen on --live) call `trigger`; keep
+    watching for `watch_s` simulated seconds after it."""
+    with _rig(profile) as (sitl, watch_udp, watch_mocap, proxy, tap):
+        argv = [sys.executable, "-m", "gcs", "fly", "--connect", proxy.address, "--mocap",
+                sitl.mocap_url, "--profile", profile, "--alt", f"{SETPOINT_M}", "--hold", "20",
+                "--json", "--live", "--no-record", "--speedup", f"{SPEEDUP:g}", "--fix-failsafe",
+                *extra]
+        proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                cwd=ROOT, env=dict(os.environ, PYTHONUNBUFFERED="1"))
+        event_wall: list[float] = []
+        err: list[str] = []
+
+        def read() -> None:
+            assert proc.stdout is not None
+            for line in proc.stdout:
+                if not event_wall and line.startswith(phase + " "):
+                    time.sleep(after_s / SPEEDUP)  # pacing the trigger, not synchronising
+                    trigger(proc, proxy, watch_udp)
+                    event_wall.append(time.monotonic())
+
+        readers = [threading.Thread(target=read, daemon=True),
+                   threading.Thread(target=lambda: err.extend(proc.stderr or []), daemon=True)]
+        for r in readers:
+            r.start()
+        deadline = time.monotonic() + 200.0
+        while time.monotonic() < deadline and not event_wall and proc.poll() is None:
+            time.sleep(0.05)  # polling a condition with a deadline
+        end = (event_wall[0] if event_wall else time.monotonic()) + watch_s / SPEEDUP
+        while time.monotonic() < end:
+            time.sleep(0.05)
+        try:
+            code = proc.wait(timeout=60.0)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            code = proc.wait()
+        for r in readers:
+            r.join(5.0)
+        clock = SimClockMap(watch_mocap.mocap)
+        mocap = np.array([(s, h) for _, s, h in watch_mocap.mocap], dtype=float).reshape(-1, 2)
+        t_s, up_m = mocap[:, 0], mocap[:, 1]
+        ground = up_m[t_s <= t_s[0] + 1.0]
+        return Run(code, "".join(err), t_s, up_m - float(np.median(ground)) + REST_ALT_M,
+                   clock(event_wall[0]) if event_wall else None,
+                   [(clock(w), a, m) for w, a, m in watch_udp.heartbeats],
+                   [(clock(w), text) for w, text in watch_udp.texts],
+                   [(clock(w), thr) for w, thr in tap.throttle])
+
+
+def _lands_safely(r: Run) -> None:
+    assert r.event_s is not None, f"the event never happened: exit {r.exit_code} {r.reason!r}"
+    assert r.alt_m.max() <= SETPOINT_M + 0.3, f"rose to {r.alt_m.max():.2f} m"
+    down = r.touchdown()
+    assert down is not None, "never back on the floor"
+    assert down[0] - r.event_s <= 20.0 and down[1] <= 1.0, f"touchdown {down}"
+    off = r.disarmed_s()
+    assert off is not None and off - r.event_s <= 20.0, f"disarmed at {off} (event {r.event_s})"
+
+
+@pytest.mark.parametrize("profile", ["apm25", "copter4"])
+def test_station_sigkilled_mid_air_is_landed_by_the_vehicles_failsafe(profile: str) -> None:
+    r = fly(profile, lambda proc, _p, _w: proc.send_signal(signal.SIGKILL))
+    _lands_safely(r)
+    assert r.exit_code == -signal.SIGKILL
+
+
+def test_auto_disarm_before_takeoff_is_reported_and_nothing_winds_up() -> None:
+    r = fly("apm25", lambda *_: None, phase="armed", after_s=0.0,
+            extra=("--takeoff-delay", "25"), watch_s=20.0)
+    assert r.exit_code == 3 and "disarm" in r.reason, r.reason
+    assert r.alt_m.max() <= REST_ALT_M + 0.05  # never left the floor
+    assert r.overrides and max(thr for _, thr in r.overrides) == 1000
+
+
+def _land_from_elsewhere(_proc: subprocess.Popen[str], _proxy: FaultProxy, w: MavWatcher) -> None:
+    mav = mavlink.MAVLink(None, srcSystem=255, srcComponent=50)
+    msg = mavlink.MAVLink_set_mode_message(1, 1, MODE_LAND)
+    assert w.peer is not None
+    w.sock.sendto(msg.pack(mav), w.peer)
+
+
+def test_land_from_elsewhere_mid_hold_ends_pc_control_and_lands() -> None:
+    r = fly("apm25", _land_from_elsewhere)
+    _lands_safely(r)
+    assert r.exit_code == 3 and "LAND" in r.reason, r.reason
+    assert r.event_s is not None
+    land_seen = next(t for t, armed, mode in r.heartbeats if t >= r.event_s and mode == MODE_LAND)
+    later = [thr for t, thr in r.overrides if t > land_seen + 0.5]
+    assert later and max(later) == 1000  # throttle at minimum in LAND: nothing winds up
+
+
+def _kill_in_fault(direction: Direction, fault_s: float) -> Trigger:
+    def trigger(proc: subprocess.Popen[str], proxy: FaultProxy, _w: MavWatcher) -> None:
+        proxy.drop(direction, fault_s)
+        time.sleep(1.5 / SPEEDUP)  # the fault has begun: the station is blind or unheard
+        proc.send_signal(signal.SIGQUIT)
+    return trigger
+
+
+@pytest.mark.parametrize("direction", [Direction.DOWN, Direction.UP, Direction.BOTH],
+                         ids=lambda d: d.value)
+def test_kill_during_a_link_loss_cuts_the_throttle_and_disarms_once_heard(
+        direction: Direction) -> None:
+    fault_s = 6.0
+    r = fly("copter4", _kill_in_fault(direction, fault_s), watch_s=20.0)
+    assert r.event_s is not None
+    kill_s = r.event_s + 1.5
+    assert r.exit_code == 3 and "KILL" in r.reason, r.reason
+    reaching = [(t, thr) for t, thr in r.overrides if t >= kill_s + 0.1]
+    if direction is Direction.DOWN:  # the uplink works: the cut arrives at once
+        assert reaching and reaching[0][0] - kill_s <= 0.3 and reaching[0][1] == 1000
+    assert all(thr == 1000 for _, thr in reaching)
+    uplink_back = r.event_s + (0.0 if direction is Direction.DOWN else fault_s)
+    off = r.disarmed_s()
+    assert off is not None and off - max(uplink_back, kill_s) <= 1.0
