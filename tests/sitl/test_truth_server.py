@@ -7,6 +7,7 @@ import select
 import time
 from collections.abc import Callable
 
+import numpy as np
 import pytest
 
 from firmware_link.truth_link import TruthLink, TruthRecorder
@@ -87,3 +88,15 @@ def test_recorder_keeps_one_vehicles_reports_and_closes() -> None:
     finally:
         server.close()
     assert all(r.sysid == 2 for r in rec.reports())
+
+
+def test_station_time_follows_a_sender_that_slips() -> None:
+    """A loaded SITL falls behind and resynchronises its clock: from then on its reports carry
+    simulated times 0.5 s behind. Each report keeps the delay of its own neighbourhood."""
+    sim_t = [k * 0.02 for k in range(500)]  # 10 s of reports
+    rx = [100.0 + t + 0.002 + (0.5 if t >= 5.0 else 0.0) for t in sim_t]
+    s = station_time(rx, sim_t, [0.0] * 500)
+    late = np.array(sim_t) > 6.05  # a window (1 s) past the slip
+    early = np.array(sim_t) < 3.95
+    assert np.allclose(s.t_s[late], np.array(rx)[late], rtol=0.0, atol=1e-9)
+    assert np.allclose(s.t_s[early], np.array(rx)[early], rtol=0.0, atol=1e-9)
