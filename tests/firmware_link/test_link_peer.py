@@ -167,12 +167,10 @@ def test_watchdog_lost_then_regained_after_tcp_reopen() -> None:
         v.crash()
         records = poll_until(link, lambda rs: events(rs, LinkEventKind.LOST), timeout_s=4.0)
         lost = events(records, LinkEventKind.LOST)[0]
-        last_hb = max(r.t_s for r in records if type(r).__name__ == "Heartbeat") if any(
-            type(r).__name__ == "Heartbeat" for r in records) else None
         assert link.lost
         assert events(records, LinkEventKind.RECONNECTING)
-        if last_hb is not None:
-            assert 1.5 <= lost.t_s - last_hb <= 2.0
+        # proof of life is any frame: lost 1.5 s after the last one, whatever its type
+        assert 1.5 <= lost.t_s - link.last_rx_s <= 2.0
         start = time.monotonic()
         link.poll()
         assert time.monotonic() - start < 0.05  # reconnect attempts never block poll()
@@ -196,7 +194,8 @@ def test_silence_declares_lost_between_1_5_and_2_s() -> None:
             records = poll_until(link, lambda rs: events(rs, LinkEventKind.LOST), timeout_s=4.0)
             last_hb = max([*hb_t, *(r.t_s for r in records if type(r).__name__ == "Heartbeat")])
             lost = events(records, LinkEventKind.LOST)[0]
-            assert 1.5 <= lost.t_s - last_hb <= 2.0
+            assert 1.5 <= lost.t_s - last_hb <= 2.0  # this vehicle sends heartbeats only
+            assert last_hb == link.last_heartbeat_s <= link.last_rx_s
             v.paused.clear()
             poll_until(link, lambda rs: events(rs, LinkEventKind.REGAINED), timeout_s=3.0)
     finally:
