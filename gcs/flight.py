@@ -361,8 +361,8 @@ class FlightRunner:
         origin = self.truth_origin_m()
         if origin is None:
             return None
-        reports = distinct_reports([s.t_s for s in self.samples],
-                                   [s.truth_alt_m for s in self.samples])
+        samples = tuple(self.samples)  # the loop thread may append while we read
+        reports = distinct_reports([s.t_s for s in samples], [s.truth_alt_m for s in samples])
         return Series(reports.t_s, reports.alt_m - origin)
 
     def _alt(self, source: str, truth: Series | None, t0_s: float, t1_s: float) -> Series | None:
