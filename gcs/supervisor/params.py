@@ -32,7 +32,9 @@ class SupervisorParams:
     """Timings in seconds of the station clock, PWM in µs."""
 
     degraded_after_s: float = 0.3  # 12 ticks of 40 Hz telemetry missing
-    lost_after_s: float = 1.0
+    # ArduCopter 3.2.1 goes quiet for up to ~1 s while it arms (it recalibrates the barometer
+    # in its main loop: the fixture tlog has gaps of 0.85 s and 1.01 s), so 1.5 s, not less
+    lost_after_s: float = 1.5
     land_request_s: float = 3.0  # LAND commanded this long before going silent
     mode_resend_s: float = 0.5
     disarm_resend_s: float = 0.2  # kill: ≥ 5 Hz

@@ -168,7 +168,7 @@ def test_downlink_loss_lands_then_goes_silent_and_does_not_resume() -> None:
     assert board.h == pytest.approx(1.0, abs=0.05)
     board.lost = True  # the vehicle's frames stop; the station's still arrive
     n0 = len(board.overrides)
-    run_s(st, 1.5)
+    run_s(st, 2.0)
     assert st.snapshot().state is SupervisorState.LINK_LOST
     assert FlightMode.LAND in board.modes
     held = board.overrides[-1]

@@ -182,7 +182,7 @@ def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
     s.hovering()
     s.run(1.0)
     s.down = False
-    outs = s.run(1.2)
+    outs = s.run(1.6)
     assert s.sup.state is S.LINK_LOST
     outs += s.run(2.9)
     lands = actions(outs, ActionKind.SET_MODE)
@@ -350,6 +350,6 @@ def test_intents_are_ignored_while_the_link_is_lost_except_kill() -> None:
     s = Script()
     s.hovering()
     s.down = False
-    s.run(1.2)
+    s.run(1.6)
     out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=2.0))
     assert s.sup.state is S.LINK_LOST and any("ignored" in n.text for n in out.notes)
