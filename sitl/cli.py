@@ -152,6 +152,9 @@ What a ground station sees:
   ground truth    SIM_STATE (EXTRA1 stream, at the ATTITUDE rate), for evaluation only;
                   capped at 10 Hz on the serial port so it leaves the 115200-baud budget
                   to the control streams. No SIMSTATE (it has no altitude).
+                  With --truth-port: its own endpoint, `truth tcp:...`, sysid 201, compid =
+                  vehicle: LOCAL_POSITION_NED at 50 Hz, z from the floor, time_boot_ms =
+                  simulated time (sitl/truth_server.py), for scoring only.
   serial port     MAVLink 1 frames (apm25) carry base payloads only, as a real v1 sender.
   failsafes       apm25: FS_GCS_ENABLE 1, 5 s after the last heartbeat or override while
                   overrides are in use; radio failsafe 2 s after the last override (no
