@@ -4,12 +4,15 @@ firmware words them, firmware identification and loud parameters."""
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Iterator
 
 import pytest
 
 from firmware_link import LinkError, LinkUsageError, ParamError, VehicleLink, key_from_passphrase
+from firmware_link.connection import parse_connection_string
+from firmware_link.frames import FrameEndpoint
 from firmware_link.protocol import WireVersion
 from firmware_link.records import Attitude, Dialect, FlightMode, LinkEventKind, RcCommand
 from tests.firmware_link.peer import FakeVehicle, wait_until
@@ -43,6 +46,17 @@ def test_telemetry_without_heartbeats_keeps_the_link_alive() -> None:
             poll_until(link, lambda rs: events(rs, LinkEventKind.REGAINED), timeout_s=3.0)
     finally:
         v.stop()
+
+
+def test_before_any_frame_times_are_minus_infinity() -> None:
+    spec = parse_connection_string("tcp:127.0.0.1:5760")
+    endpoint = FrameEndpoint(None, source_system=255, source_component=190, clock=time.monotonic)
+    link = VehicleLink(spec, endpoint, clock=time.monotonic, wall_clock=time.time,
+                       signing_key=None)
+    assert link.last_rx_s == link.last_heartbeat_s == -math.inf
+    assert link.dialect is Dialect.UNKNOWN and link.pending_override is None
+    assert not link.rc_override(RcCommand())  # no transport: dropped and counted
+    assert link.stats.tx_dropped == 1
 
 
 def test_gcs_heartbeat_can_be_switched_off_and_on(apm25: FakeVehicle) -> None:
@@ -80,6 +94,7 @@ def test_a_stalled_reader_never_blocks_an_override(profile: str, serial: bool) -
             stats = link.stats
             assert stats.tx_dropped_overrides >= 49
             assert stats.tx_queued_bytes > 0 and stats.tx_backpressure >= 1
+            assert link.flush() == link.stats.tx_queued_bytes > 0  # still stalled: bytes wait
             queued = 0
             while link.send_set_mode(FlightMode.STABILIZE):  # commands queue, bounded
                 queued += 1
