@@ -38,6 +38,7 @@ from sitl.autopilot.throttle_curve import (
 STICK_DZ_US = 30  # RCn_DZ for roll/pitch
 YAW_DZ_US = 40
 GYRO_CAL_S = 1.0  # boot-time gyro calibration of the attitude estimator
+LAND_PAUSE_S = 4.0  # LAND_WITH_DELAY_MS of both firmwares
 
 
 class Autopilot:
@@ -76,6 +77,7 @@ class Autopilot:
         self._arming_until_s: float | None = None  # 3.2.1: arming in progress until then
         self.arm_completed: CommandResult | None = None  # a pending arm's answer, once
         self._want_thrust = False
+        self._land_pause_until_s = 0.0
         self._t_s = 0.0
         self._zero_throttle_s = 0.0
         self._last_throttle = 0.0
@@ -159,6 +161,12 @@ class Autopilot:
             self._enter_mode(mode)
         return CommandResult(True)
 
+    def _land_with_pause(self) -> None:
+        """A failsafe's LAND (set_mode_land_with_pause, both firmwares): hold the height for
+        LAND_WITH_DELAY_MS (4 s), so a pilot can take over, then descend."""
+        self._enter_mode(FlightMode.LAND)
+        self._land_pause_until_s = self._t_s + LAND_PAUSE_S
+
     def _enter_mode(self, mode: FlightMode) -> None:
         if mode in (FlightMode.ALT_HOLD, FlightMode.LAND):
             self.alt_ctrl.reset(
@@ -166,6 +174,7 @@ class Autopilot:
             )
         self.state.mode = mode
         self.state.hold_for_gcs = False
+        self._land_pause_until_s = 0.0
 
     @property
     def arming_in_progress(self) -> bool:
@@ -353,7 +362,8 @@ class Autopilot:
             if self.land.landed and self._last_throttle <= 0.0:
                 self.alt_ctrl.init_takeoff(self.inav.alt_m * 100.0)
         else:  # LAND
-            climb = -self.gains.land_speed_cms
+            paused = self._t_s < self._land_pause_until_s and not self.land.landed
+            climb = 0.0 if paused else -self.gains.land_speed_cms
             self._want_thrust = not self.land.landed
             if not st.armed or self.land.landed:
                 self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
@@ -411,7 +421,7 @@ class Autopilot:
         if self.land.landed or (st.mode is FlightMode.STABILIZE and stick_zero):
             self._disarm()
         elif st.mode is not FlightMode.LAND:
-            self._enter_mode(FlightMode.LAND)
+            self._land_with_pause()
 
     def _failsafes(self, t_s: float, battery_v: float) -> None:
         st = self.state
@@ -458,8 +468,8 @@ class Autopilot:
             if st.armed:
                 if self.land.landed:
                     self._disarm()
-                else:
-                    self._enter_mode(FlightMode.LAND)
+                elif st.mode is not FlightMode.LAND:
+                    self._land_with_pause()
 
     @property
     def booting(self) -> bool:

@@ -257,12 +257,15 @@ def test_apm25_radio_failsafe_lands_2_s_after_the_last_override_overrides_stay()
     pilot.overrides = False  # heartbeats go on: no GCS failsafe
     msgs = pilot.fly(1.8)
     assert _hb(gcs)[0] == 0
+    held = truth_alt(gcs)
     msgs = pilot.fly(1.4)
     assert _hb(gcs) == (9, 209, 5)  # LAND, armed, CRITICAL
     assert not _texts(gcs, msgs)  # 3.2.1 announces no failsafe
     # overrides never expire on 3.2.1: the radio still reads the last one
     msgs = pilot.fly(2.0)
     assert gcs.of_type("RC_CHANNELS_RAW", msgs)[-1].chan3_raw == HOVER_STICK_US
+    # a failsafe's LAND holds the height 4 s first (set_mode_land_with_pause)
+    assert truth_alt(gcs) == pytest.approx(held, abs=0.3)
     for _ in range(40):
         pilot.fly(0.5)
         if _hb(gcs)[1] == 81:
