@@ -11,8 +11,10 @@ Opening identifies the firmware from what the vehicle says (`link.firmware`, a F
 Blocking helpers (`arm`, `set_mode`, `read_params`, `set_param`, `fetch_params`, `identify`,
 `bring_up`) are for the loop's thread between ticks; `send_arm`/`send_disarm`/`send_set_mode`
 and `rc_override` return at once (sends never block: see `tx_queue`) and the outcome arrives as
-CommandAck / Heartbeat records. Errors are `LinkError` (exit 1; `ParamError` for parameters) or
-`LinkUsageError` (exit 2), one line each. `.parm` files: `parm_file`.
+CommandAck / Heartbeat records. Link health: `lost` (no frame of any kind for 1.5 s),
+`last_rx_s`, `last_heartbeat_s`; `set_gcs_heartbeat(False)` silences the station's heartbeat so
+the vehicle's own GCS failsafe can act. Errors are `LinkError` (exit 1; `ParamError` for
+parameters) or `LinkUsageError` (exit 2), one line each. `.parm` files: `parm_file`.
 """
 
 from firmware_link.connection import ConnectionSpec, Transport, parse_connection_string
