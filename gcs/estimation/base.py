@@ -147,8 +147,7 @@ class AltEstimator(ABC):
         self._repeat_vel_mps = 0.0
         self._value_rx_s = -math.inf  # when the current value first arrived
         self._doubt_until_s = -math.inf  # repeats are not readings until then (see sonar_doubt_s)
-        self._reading_late = False  # whether the last reading used was taken as a late echo
-        self._duplicates_total = 0
+        self._reading_late = False  # whether the reading just used was taken as a late echo
         self._history: deque[tuple[float, float]] = deque()  # (t_s, alt_m) after each predict
         self._rejected: deque[tuple[float, float]] = deque()  # (t_s, sonar alt), consecutive
         self._rejected_total = 0
@@ -237,12 +236,7 @@ class AltEstimator(ABC):
                 return alt
         return self._history[0][1]
 
-    @property
-    def duplicates_total(self) -> int:
-        """Sonar messages taken for the stream's repeats of a reading already used."""
-        return self._duplicates_total
-
-    def _is_new_reading(self, d: float, t_s: float, alt_pred: float) -> bool:
+    def _is_new_reading(self, d: float, t_s: float) -> bool:
         """Whether a sonar message carries a reading the sensor took since the last one.
 
         A changed value is new. A repeated one is new too once the sensor has had time to
@@ -262,7 +256,7 @@ class AltEstimator(ABC):
         d = sonar.distance_m if sonar.valid else 0.0
         # the message's own arrival (receive stamp) times the repeat test; the tick's time
         # (`t_s`) times everything the filter does with the reading
-        fresh = self._is_new_reading(d, sonar.t_s, alt_pred)
+        fresh = self._is_new_reading(d, sonar.t_s)
         changed = d != self._last_distance
         prev_new_t_s = self._last_new_t_s
         if fresh:
@@ -277,8 +271,6 @@ class AltEstimator(ABC):
             self._value_rx_s = sonar.t_s
             self._repeat_move_m = (self._late_shift(prev_new_t_s, alt)[0]
                                    if self._reading_late else 0.0)
-        if result[0] is SonarStatus.DUPLICATE:
-            self._duplicates_total += 1
         if fresh:
             # the HC-SR04 sends its next ping as soon as an echo (or its timeout) is in
             self._on_ping(t_s)
@@ -312,6 +304,7 @@ class AltEstimator(ABC):
         alt_pred: float,
     ) -> tuple[SonarStatus, float]:
         p = self.params
+        self._reading_late = False
         in_range = sonar.valid and p.sonar_min_m <= d <= p.sonar_max_m
         if not in_range:
             if d <= p.sonar_min_m and alt_pred < p.ground_alt_m:
@@ -324,7 +317,6 @@ class AltEstimator(ABC):
                 # a lost echo in the air: carpet (or beyond range), where repeats mislead
                 self._doubt_until_s = sonar.t_s + p.sonar_doubt_s
             return SonarStatus.INVALID, 0.0
-        self._reading_late = False
         if not fresh:
             return SonarStatus.DUPLICATE, 0.0
         z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
