@@ -18,6 +18,7 @@ Prints numbers; asserts nothing.
 
     .venv/bin/python bench/faults.py [--speedup K] [--profile apm25|copter4|both]
                                      [--case downlink ...] [--serial] [--seed N]
+                                     [--record DIR]
 """
 
 from __future__ import annotations
@@ -87,6 +88,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--serial", action="store_true",
                     help="also fly both-ways loss over the serial pty (apm25)")
     ap.add_argument("--seed", type=int, default=3, help="SITL noise and fault seed (default 3)")
+    ap.add_argument("--record", type=Path, metavar="DIR",
+                    help="keep fly's MCAP recording of each flight in DIR (default none)")
     args = ap.parse_args(argv)
     if args.speedup is not None and not 0 < args.speedup <= 50:
         print(f"bench/faults.py: --speedup {args.speedup}: expected 0 < K <= 50",
@@ -100,7 +103,9 @@ def main(argv: list[str] | None = None) -> int:
                                          "three flights at a time)")
     print(f"bench/faults.py  seed={args.seed} flights={len(specs)}{note}", flush=True)
     t0 = time.monotonic()
-    results = run_many(specs, seed=args.seed, speedup=args.speedup)
+    if args.record is not None:
+        args.record.mkdir(parents=True, exist_ok=True)
+    results = run_many(specs, seed=args.seed, speedup=args.speedup, record_dir=args.record)
     print(f"\n{'fault':15s} {'profile':8s} {'documented response':66s} {'over set':>9s} "
           f"{'touch m/s':>9s} {'disarm s':>9s} {'exit':>5s}")
     for spec in specs:

@@ -41,8 +41,8 @@ MODE_LAND = 9
 FLOOR_BAND_M = 0.03  # within this of the resting altitude: on the floor
 # Sped up, the serial line keeps its baud rate in simulated time, so it gets the smaller factor
 # (as the alt-hold e2e tests fly it).
-TCP_SPEEDUP, SERIAL_SPEEDUP = 4.0, 2.0
-REALTIME_WORKERS = 3
+TCP_SPEEDUP, SERIAL_SPEEDUP = 2.0, 2.0
+REALTIME_WORKERS = 3  # flights at once in real time; sped up K times, about 3/K of them
 
 
 @dataclass(frozen=True, slots=True)
@@ -202,6 +202,17 @@ class FlightResult:
         return float(np.max(np.abs(self.alt_m[sel] - SETPOINT_M))) if sel.any() else None
 
     @property
+    def pre_fault_rms_m(self) -> float | None:
+        """RMS height error over the 10 s before the fault: how well the run flew at all (a
+        machine too loaded for the speed-up shows here first)."""
+        if self.fault_start_s is None:
+            return None
+        sel = (self.t_s >= self.fault_start_s - 10.0) & (self.t_s < self.fault_start_s)
+        if not sel.any():
+            return None
+        return float(np.sqrt(np.mean((self.alt_m[sel] - SETPOINT_M) ** 2)))
+
+    @property
     def last_throttle_us(self) -> tuple[int, float, float] | None:
         """(the last throttle the vehicle received before the fault, the median and the
         half-width of the 5-95 % band of the 10 s before): what it flies open-loop on."""
@@ -214,6 +225,11 @@ class FlightResult:
         lo, mid, hi = np.percentile(before, (5, 50, 95))
         return before[-1], float(mid), float(hi - lo) / 2.0
 
+    def _score(self) -> str:
+        s = self.summary or {}
+        keys = ("status", "rms_error_m", "max_error_m", "error_source", "link_down_s")
+        return ", ".join(f"{k} {s[k]}" for k in keys if k in s) or "none"
+
     def report(self) -> str:
         """The run in a few lines, for assertion messages and the bench."""
         def f(x: float | None, unit: str) -> str:
@@ -225,7 +241,8 @@ class FlightResult:
 
         drift = self.open_loop_drift_m
         return (f"{self.case.name}/{self.profile}/{self.transport} x{self.speedup:g}: exit "
-                f"{self.exit_code} ({self.reason!r}); fault at t={f(t0, ' s')}; max over "
+                f"{self.exit_code} ({self.reason!r}); fault at t={f(t0, ' s')}; hold RMS "
+                f"before it {f(self.pre_fault_rms_m, ' m')}; max over "
                 f"setpoint {f(self.max_over_setpoint_m, ' m')}; touchdown "
                 f"{f(rel(self.touchdown_s), ' s')} after the fault at "
                 f"{f(self.touchdown_speed_mps, ' m/s')}; disarmed {f(rel(self.disarm_s), ' s')}"
@@ -235,7 +252,8 @@ class FlightResult:
                 f"; last throttle before the fault (us, hold median, ±5-95 %) "
                 f"{self.last_throttle_us}"
                 f"; hold dev in fault {f(self.hold_during_fault_m, ' m')}; params "
-                f"{self.params}; proxy up [{self.up.line()}] down [{self.down.line()}]; "
+                f"{self.params}; fly's own score {self._score()}; proxy up [{self.up.line()}] "
+                f"down [{self.down.line()}]; "
                 f"{self.wall_s:.0f} s wall")
 
 
@@ -274,8 +292,10 @@ def _sitl(args: list[str]) -> Iterator[Any]:
 
 
 def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
-                   speedup: float = 4.0, seed: int = 3) -> FlightResult:
-    """Fly 1.0 m, start `case` 30 s into the hold, watch until it is over; the result."""
+                   speedup: float = TCP_SPEEDUP, seed: int = 3,
+                   record: Path | None = None) -> FlightResult:
+    """Fly 1.0 m, start `case` 30 s into the hold, watch until it is over; the result.
+    `record`: fly's MCAP recording to this file (default none: it costs the station CPU)."""
     if not speedup_allowed():
         speedup = 1.0
     wall0 = time.monotonic()
@@ -308,7 +328,7 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
         stack.callback(proxy.stop)
         argv = [sys.executable, "-m", "gcs", "fly", "--connect", connect, "--mocap", mocap_url,
                 "--profile", profile, "--alt", f"{SETPOINT_M}", "--hold", f"{hold_s:g}",
-                "--json", "--live", "--no-record"]
+                "--json", "--live", *(["-o", str(record)] if record else ["--no-record"])]
         if speedup != 1.0:
             argv += ["--speedup", f"{speedup:g}"]
         if "--fix-failsafe" in _fly_flags():
@@ -411,11 +431,12 @@ class FlightSpec:
 
 
 def run_many(specs: list[FlightSpec], seed: int = 3, speedup: float | None = None,
-             ) -> dict[FlightSpec, FlightResult | Exception]:
-    """Fly every spec: one after another when sped up (each then needs about a core), three
-    at a time in real time (each needs about a quarter of one), longest first. `speedup`
-    None: 4x over TCP, 2x over serial, when `fly` allows it. A flight that could not be flown
-    (the SITL would not start, say) is its exception, so the others still count."""
+             record_dir: Path | None = None) -> dict[FlightSpec, FlightResult | Exception]:
+    """Fly every spec, longest first, a few at a time: in real time a flight needs about a
+    quarter of a core, sped up K times about K quarters. `speedup` None: TCP_SPEEDUP over TCP,
+    SERIAL_SPEEDUP over serial, when `fly` allows it. `record_dir`: one MCAP per flight. A
+    flight that could not be flown (the SITL would not start, say) is its exception, so the
+    others still count."""
     if not specs:
         return {}
     speedup_ok = speedup_allowed() and speedup != 1.0
@@ -425,11 +446,13 @@ def run_many(specs: list[FlightSpec], seed: int = 3, speedup: float | None = Non
         if speedup_ok and speedup is not None:
             k = speedup
         try:
-            return fly_with_fault(CASES[spec.case], spec.profile, spec.transport, k, seed)
+            rec = None if record_dir is None else record_dir / f"{spec.id}.mcap"
+            return fly_with_fault(CASES[spec.case], spec.profile, spec.transport, k, seed, rec)
         except Exception as exc:  # reported by the caller, per flight
             return exc
 
     order = sorted(specs, key=lambda s: -CASES[s.case].duration_s)
-    workers = 1 if speedup_ok else REALTIME_WORKERS
+    k_max = max(speedup or TCP_SPEEDUP, SERIAL_SPEEDUP) if speedup_ok else 1.0
+    workers = max(1, round(REALTIME_WORKERS / k_max))
     with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
         return dict(zip(order, pool.map(one, order), strict=True))
