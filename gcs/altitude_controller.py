@@ -120,18 +120,20 @@ class AltitudeController:
         return round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
 
     def update(self, setpoint_m: float, estimate: AltEstimate, roll_rad: float, pitch_rad: float,
-               dt_s: float, *, on_floor: bool = False) -> AltControlOutput:
+               dt_s: float, *, on_floor: bool = False,
+               rate_mps: float | None = None) -> AltControlOutput:
         """One step: setpoint altitude (up, m) and the estimate → throttle stick PWM.
 
         `on_floor`: the vehicle stands on the floor, so thrust below its weight changes nothing
-        and the integrator must not wind up against it."""
+        and the integrator must not wind up against it. `rate_mps`: the setpoint profile's speed
+        for this move (None: the controller's own)."""
         p = self.params
         error = setpoint_m - estimate.alt_m
         integrate = not (on_floor or (self._clamped > 0 and error > 0.0)
                          or (self._clamped < 0 and error < 0.0))
         terms: PidTerms = self.pid.update(setpoint_m, estimate.alt_m, dt_s,
                                           measurement_rate=estimate.vel_mps,
-                                          integrate=integrate)
+                                          integrate=integrate, slew_per_s=rate_mps)
         tilt = self._tilt(roll_rad, pitch_rad)
         thrust = p.mass_kg * (GRAVITY_MPS2 + terms.out) / tilt
         motor = self.hover_throttle * thrust / (p.mass_kg * GRAVITY_MPS2)

@@ -113,7 +113,7 @@ class Pid:
         self._i = min(max(output, -g.i_max), g.i_max)
         self._last_out = output
 
-    def _shape(self, target: float, dt_s: float) -> float:
+    def _shape(self, target: float, dt_s: float, slew_per_s: float | None = None) -> float:
         """Move the shaped setpoint towards `target`; return its rate for the feed-forward.
 
         Unlimited slew: the setpoint jumps (rate 0, so no kick). Slew only: a ramp. Slew and
@@ -121,12 +121,14 @@ class Pid:
         feed-forward never asks for more than the profile's acceleration."""
         g = self.gains
         assert self._shaped is not None
-        if not math.isfinite(g.setpoint_slew_per_s):
+        slew = g.setpoint_slew_per_s if slew_per_s is None else min(slew_per_s,
+                                                                     g.setpoint_slew_per_s)
+        if not math.isfinite(slew):
             self._shaped = target
             return 0.0
         dist = target - self._shaped
-        want = math.copysign(min(g.setpoint_slew_per_s, math.sqrt(2.0 * g.setpoint_accel_per_s2
-                                                                   * abs(dist))), dist)
+        want = math.copysign(min(slew, math.sqrt(2.0 * g.setpoint_accel_per_s2 * abs(dist))),
+                             dist)
         if math.isfinite(g.setpoint_accel_per_s2):
             dv = g.setpoint_accel_per_s2 * dt_s
             rate = self._shaped_rate + min(max(want - self._shaped_rate, -dv), dv)
@@ -147,17 +149,19 @@ class Pid:
         measurement_rate: float | None = None,
         *,
         integrate: bool = True,
+        slew_per_s: float | None = None,
     ) -> PidTerms:
         """One step: returns the terms and the saturated output. With `integrate` False the
         integrator holds its value (the caller knows the actuator beyond the PID is clamped, or
-        the plant cannot respond, e.g. a vehicle standing on the floor)."""
+        the plant cannot respond, e.g. a vehicle standing on the floor). `slew_per_s` lowers the
+        setpoint profile's speed for this move (a slow climb), braking as the profile does."""
         if dt_s <= 0.0:
             raise ValueError(f"dt_s must be > 0, got {dt_s}")
         g = self.gains
         if self._shaped is None:
             self._shaped = target
         prev_rate = self._shaped_rate
-        shaped_rate = self._shape(target, dt_s)
+        shaped_rate = self._shape(target, dt_s, slew_per_s)
         # clamp: the profile's last step onto the target ends its rate in one tick
         accel = min(max((shaped_rate - prev_rate) / dt_s, -g.setpoint_accel_per_s2),
                     g.setpoint_accel_per_s2)

@@ -434,15 +434,13 @@ class Supervisor:
             self._note(Level.INFO, "telemetry back: altitude hold resumes")
         est = inp.estimate
         assert self.alt_setpoint_m is not None
-        target = self.alt_target_m if self.alt_target_m is not None else self.alt_setpoint_m
-        if self.alt_rate_mps is None:
-            self.alt_setpoint_m = target
-        else:
-            step = self.alt_rate_mps * inp.dt_s
-            self.alt_setpoint_m += min(max(target - self.alt_setpoint_m, -step), step)
+        # the controller's setpoint profile makes the move (at the asked rate, braking before
+        # the target): a ramp that stops dead at the target overshoots it
+        if self.alt_target_m is not None:
+            self.alt_setpoint_m = self.alt_target_m
         floor = self.on_floor(est.alt_m) and self.alt_setpoint_m <= est.alt_m
         self.alt = self.alt_ctrl.update(self.alt_setpoint_m, est, inp.roll_rad, inp.pitch_rad,
-                                        inp.dt_s, on_floor=floor)
+                                        inp.dt_s, on_floor=floor, rate_mps=self.alt_rate_mps)
         s = self.sticks
         roll, pitch, yaw = s.roll_us, s.pitch_us, s.yaw_us
         self.position = None
