@@ -111,6 +111,7 @@ class FakeBoard:
 
     def send_set_mode(self, mode: FlightMode | int) -> bool:
         self.modes.append(int(mode))
+        self.mode = int(mode)  # `lost` is the downlink: commands still arrive
         return True
 
     def set_gcs_heartbeat(self, enabled: bool) -> None:
@@ -178,13 +179,13 @@ def test_downlink_loss_lands_then_goes_silent_and_does_not_resume() -> None:
     n1 = len(board.overrides)
     run_s(st, 1.0)
     assert len(board.overrides) == n1 > n0 and board.heartbeats_on == [False]
-    board.lost = False  # back, still armed in STABILIZE: nothing resumes, LAND is asked again
-    modes_before = len(board.modes)
+    assert board.mode == FlightMode.LAND  # the uplink carried the LAND request
+    board.lost = False  # back: the vehicle is landing in LAND, and nothing resumes
     run_s(st, 2.0)
     snap = st.snapshot()
-    assert snap.state is SupervisorState.LINK_LOST and board.heartbeats_on == [False, True]
-    assert board.modes[modes_before:] and set(board.modes[modes_before:]) == {FlightMode.LAND}
+    assert snap.state is SupervisorState.VEHICLE and board.heartbeats_on == [False, True]
     assert snap.alt is None and snap.link_down_s > 3.0
+    assert board.overrides[-1].throttle_us == 1000  # LAND: throttle down, so it disarms
 
 
 def test_kill_drops_throttle_and_disarms() -> None:
@@ -250,6 +251,26 @@ def test_crash_in_the_loop_releases_overrides_and_reports() -> None:
     assert board.released == 1
     assert any(e.level is EventLevel.ERROR and "serial port vanished" in e.text
                for e in st.snapshot().events)
+
+
+def test_a_crash_with_the_vehicle_armed_asks_for_land_before_letting_go() -> None:
+    board = FakeBoard(MonotonicClock())  # type: ignore[arg-type]
+    st = Station(board, clock=MonotonicClock())
+    st.preflight(True, "test board")
+    st.start()
+    st.request_arm()
+    assert st.wait_for(lambda s: s.state is SupervisorState.MANUAL, 5.0) is not None
+
+    def broken(*_a: Any, **_k: Any) -> Any:
+        raise ZeroDivisionError("estimator bug")
+
+    st.estimator.update = broken  # type: ignore[method-assign]
+    deadline = time.monotonic() + 10.0
+    while st.running and time.monotonic() < deadline:
+        time.sleep(0.01)  # polling a condition with a deadline, not synchronising
+    assert not st.running and isinstance(st.error, ZeroDivisionError)
+    assert FlightMode.LAND in board.modes and board.mode == FlightMode.LAND
+    assert board.released == 1  # only once LAND was seen
 
 
 def test_link_events_become_station_events() -> None:
