@@ -40,6 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="recording file or directory (default flights/)")
     r.add_argument("--plot", type=Path, help="radiation: picture path (default: next to the "
                                              "recording)")
+    r.add_argument("--fix-failsafe", action="store_true",
+                   help="let the station set the vehicles' GCS failsafe parameters when the "
+                        "pre-flight checks find them unsafe; without it such a vehicle is refused")
     r.add_argument("--json", action="store_true", help="print the result as one JSON object")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     r.set_defaults(func=run)
@@ -63,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     spec = load_mission(args.file)
     options = RunOptions(kinematic=args.kinematic, connect=args.connect, mocap=args.mocap,
                          record=args.record, output=args.output, plot=args.plot,
-                         speedup=args.speedup, seed=args.seed)
+                         speedup=args.speedup, seed=args.seed, fix_failsafe=args.fix_failsafe)
     report = run_mission(spec, options, None if (args.quiet or args.json) else _progress)
     if args.json:
         print(report.to_json(), flush=True)

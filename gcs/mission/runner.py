@@ -35,6 +35,7 @@ class RunOptions:
     plot: Path | None = None
     speedup: float | None = None  # None: the mission file's
     seed: int | None = None
+    fix_failsafe: bool = False  # the pilot's consent to set unsafe GCS-failsafe parameters
 
 
 def mission_world(spec: MissionSpec) -> MissionWorld:
