@@ -225,6 +225,22 @@ class FlightResult:
         lo, mid, hi = np.percentile(before, (5, 50, 95))
         return before[-1], float(mid), float(hi - lo) / 2.0
 
+    @property
+    def gap_throttle_us(self) -> tuple[int, int, float | None] | None:
+        """What the station sent once it could no longer see (downlink dead, uplink alive):
+        (the highest throttle in the fault's first 0.5 s, the median of the next second, the
+        seconds until it released the overrides, None if it never did)."""
+        if self.fault_start_s is None or self.case.direction is not Direction.DOWN:
+            return None
+        t0 = self.fault_start_s
+        first = [thr for t, thr in self.overrides if t0 <= t < t0 + 0.5 and thr]
+        later = [thr for t, thr in self.overrides if t0 + 0.5 <= t < t0 + 1.5 and thr]
+        released = [t - t0 for t, thr in self.overrides if t >= t0 and thr == 0]
+        if not first:
+            return None
+        return (max(first), int(np.median(later)) if later else 0,
+                released[0] if released else None)
+
     def _score(self) -> str:
         s = self.summary or {}
         keys = ("status", "rms_error_m", "max_error_m", "error_source", "link_down_s")
@@ -250,7 +266,8 @@ class FlightResult:
                 f"{[(round(t - (t0 or 0), 1), s) for t, s in self.failsafe_texts]}; open-loop "
                 f"{f(self.open_loop_s, ' s')}, drift {drift and tuple(round(d, 3) for d in drift)}"
                 f"; last throttle before the fault (us, hold median, ±5-95 %) "
-                f"{self.last_throttle_us}"
+                f"{self.last_throttle_us}; station's throttle blind (max 0-0.5 s, median "
+                f"0.5-1.5 s, released after s) {self.gap_throttle_us}"
                 f"; hold dev in fault {f(self.hold_during_fault_m, ' m')}; params "
                 f"{self.params}; fly's own score {self._score()}; proxy up [{self.up.line()}] "
                 f"down [{self.down.line()}]; "
