@@ -8,11 +8,11 @@ the family and the GCS-id parameter's name: an existing name answers at once, a 
 never does, so waiting out the deadline is only for a vehicle that says nothing.
 
 The version banner is not asked for by default: PARAM_REQUEST_LIST is the only way to make
-ArduCopter 3.2.1 send "ArduCopter V3.2.1", and 3.2.1 sends nothing else while its list runs
-(≈ 16 s at about 25 parameters a second; "don't send anything else at the same time as
-parameters" in its GCS code), so asking at connect would silence the telemetry a flight needs.
-A 4.x answers AUTOPILOT_VERSION instead. `identify(ask_banner=True)` asks (on the ground only),
-and any banner heard anyway (at boot, or during `fetch_params`) is evidence for the next call.
+ArduCopter 3.2.1 send "ArduCopter V3.2.1", and 3.2.1 starves its telemetry streams while the
+list runs (≈ 16 s at about 25 parameters a second: its stream loop serves the parameter queue
+first), so asking at connect would cost the telemetry a flight's bring-up needs. A 4.x answers
+AUTOPILOT_VERSION instead. `identify(ask_banner=True)` asks (never while armed), and a banner
+heard anyway (at boot, or during `fetch_params`) is evidence for the next call.
 """
 
 from __future__ import annotations

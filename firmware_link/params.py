@@ -209,9 +209,9 @@ class ParamProtocol:
         """Every parameter, by name; the ones a lossy link dropped are asked for by index.
 
         Fails (ParamError) after `timeout_s` in all, or `FETCH_STALL_S` without a new one:
-        ArduCopter 3.2.1 sends about 25 a second (412 take 16 s) and no telemetry at all
-        meanwhile, so this is for the ground; 4.x sends over 1,300 in ≈ 1 s. The version banner
-        both send first is kept as firmware evidence for the next `identify()`.
+        ArduCopter 3.2.1 sends about 25 a second (412 take 16 s) and starves its telemetry
+        streams meanwhile, so this is for the ground; 4.x sends over 1,300 in ≈ 1 s. The
+        version banner both send first is kept as firmware evidence for the next `identify()`.
         """
         start = self._clock()
         deadline = start + timeout_s
