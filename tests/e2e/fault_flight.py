@@ -290,13 +290,6 @@ def speedup_allowed() -> bool:
     return _fly_accepts_speedup_with_connect()
 
 
-@functools.cache
-def _fly_flags() -> frozenset[str]:
-    done = subprocess.run([sys.executable, "-m", "gcs", "fly", "--help"], capture_output=True,
-                          text=True, cwd=ROOT, timeout=60)
-    return frozenset(w.strip("[],") for w in done.stdout.split() if w.startswith(("--", "[--")))
-
-
 @contextlib.contextmanager
 def _sitl(args: list[str]) -> Iterator[Any]:
     from tests.e2e.sitl_proc import SitlProcess
@@ -345,11 +338,11 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
         stack.callback(proxy.stop)
         argv = [sys.executable, "-m", "gcs", "fly", "--connect", connect, "--mocap", mocap_url,
                 "--profile", profile, "--alt", f"{SETPOINT_M}", "--hold", f"{hold_s:g}",
-                "--json", "--live", *(["-o", str(record)] if record else ["--no-record"])]
+                "--json", "--live", *(["-o", str(record)] if record else ["--no-record"]),
+                # the pilot's consent: the pre-flight checks set FS_GCS_ENABLE/FS_GCS_TIMEOUT
+                "--fix-failsafe"]
         if speedup != 1.0:
             argv += ["--speedup", f"{speedup:g}"]
-        if "--fix-failsafe" in _fly_flags():
-            argv.append("--fix-failsafe")  # the pilot's consent to set FS_GCS_* before flight
         budget_s = (60.0 + hold_s + case.duration_s) / speedup + 30.0
         run = _run_fly(argv, proxy, case, budget_s)
         # keep watching: the vehicle may still be coming down after fly has given up
