@@ -2,8 +2,10 @@
 
 Schema names are exact (`foxglove.Log`, `foxglove.PoseInFrame`, `foxglove.FrameTransform`,
 `foxglove.SceneUpdate`, `foxglove.Grid`) so Foxglove's 3D, Log and Map panels recognise them.
-Times are `{"sec", "nsec"}`; the helpers leave `timestamp` out and the recorder fills it from the
-message's log time, so a caller never needs the recording's UTC anchor. Enums are integers.
+Times are `{"sec", "nsec"}`; the helpers leave `timestamp` out and `stamped()` fills it from the
+message's log time (in each scene entity and deletion for a SceneUpdate, which has no timestamp of
+its own), so a caller never needs the recording's UTC anchor. Enums are integers. Every message
+validates against Foxglove's official JSON Schema of the same name (@foxglove/schemas).
 
 Frames: poses, scenes and grids are in the station's local NED frame, `frame_id = "ned"`. Foxglove
 draws z up, so the recorder also writes one `foxglove.FrameTransform` from a z-up display frame
@@ -115,6 +117,30 @@ _CUBE = {
     "title": "foxglove.CubePrimitive",
     "properties": {"pose": _POSE, "size": _VEC3, "color": _COLOR},
 }
+_SPHERE = {
+    "type": "object",
+    "title": "foxglove.SpherePrimitive",
+    "properties": {"pose": _POSE, "size": _VEC3, "color": _COLOR},
+}
+_POINT3 = {
+    "type": "object",
+    "title": "foxglove.Point3",
+    "properties": {k: {"type": "number"} for k in ("x", "y", "z")},
+}
+_LINE = {
+    "type": "object",
+    "title": "foxglove.LinePrimitive",
+    "properties": {
+        "type": {"type": "integer", "description": "0 line strip, 1 line loop, 2 line list"},
+        "pose": _POSE,
+        "thickness": {"type": "number", "minimum": 0},
+        "scale_invariant": {"type": "boolean"},
+        "points": {"type": "array", "items": _POINT3},
+        "color": _COLOR,
+        "colors": {"type": "array", "items": _COLOR},
+        "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}},
+    },
+}
 _EMPTY_LIST = {"type": "array", "items": {"type": "object", "properties": {}}}
 
 
@@ -175,9 +201,9 @@ WELL_KNOWN_SCHEMAS: dict[str, dict[str, Any]] = {
                         "metadata": {"type": "array", "items": _KEY_VALUE},
                         "arrows": _EMPTY_LIST,
                         "cubes": {"type": "array", "items": _CUBE},
-                        "spheres": _EMPTY_LIST,
+                        "spheres": {"type": "array", "items": _SPHERE},
                         "cylinders": _EMPTY_LIST,
-                        "lines": _EMPTY_LIST,
+                        "lines": {"type": "array", "items": _LINE},
                         "triangles": _EMPTY_LIST,
                         "texts": _EMPTY_LIST,
                         "models": _EMPTY_LIST,
@@ -217,6 +243,23 @@ def time_dict(t_ns: int) -> dict[str, int]:
     """Nanoseconds since the epoch → Foxglove `{"sec", "nsec"}`."""
     sec, nsec = divmod(int(t_ns), 1_000_000_000)
     return {"sec": sec, "nsec": nsec}
+
+
+def stamped(message: FoxgloveMessage, log_ns: int) -> dict[str, Any]:
+    """The message's JSON with every timestamp its official schema requires, at `log_ns`.
+
+    A SceneUpdate has no top-level timestamp: each entity and deletion carries its own (an
+    entity is shown from that time on). Timestamps a caller set are kept.
+    """
+    data = dict(message.data)
+    stamp = time_dict(log_ns)
+    if message.schema_name == "foxglove.SceneUpdate":
+        for key in ("entities", "deletions"):
+            data[key] = [item if "timestamp" in item else {"timestamp": stamp, **item}
+                         for item in data.get(key, ())]
+    elif "timestamp" not in data:
+        data = {"timestamp": stamp, **data}
+    return data
 
 
 def _vec3(v: Sequence[float]) -> dict[str, float]:
@@ -310,22 +353,76 @@ def foxglove_scene_from_boxes(
                 "color": {"r": r, "g": g, "b": b, "a": a},
             }
         )
-    entity = {
+    return foxglove_scene([scene_entity(entity_id, cubes=cubes, frame_id=frame_id)])
+
+
+def scene_entity(
+    entity_id: str,
+    *,
+    cubes: Sequence[Mapping[str, Any]] = (),
+    spheres: Sequence[Mapping[str, Any]] = (),
+    lines: Sequence[Mapping[str, Any]] = (),
+    frame_id: str = NED_FRAME,
+    lifetime_s: float = 0.0,
+) -> dict[str, Any]:
+    """One foxglove.SceneEntity (every primitive list present, as the schema requires).
+
+    `lifetime_s` > 0 lets Foxglove drop an entity that is not refreshed in time (0: forever), so
+    a set point no longer published does not linger in the scene.
+    """
+    sec, nsec = divmod(round(max(0.0, lifetime_s) * 1e9), 1_000_000_000)
+    return {
         "frame_id": frame_id,
         "id": entity_id,
-        "lifetime": {"sec": 0, "nsec": 0},
+        "lifetime": {"sec": sec, "nsec": nsec},
         "frame_locked": False,
         "metadata": [],
         "arrows": [],
-        "cubes": cubes,
-        "spheres": [],
+        "cubes": list(cubes),
+        "spheres": list(spheres),
         "cylinders": [],
-        "lines": [],
+        "lines": list(lines),
         "triangles": [],
         "texts": [],
         "models": [],
     }
-    return FoxgloveMessage("foxglove.SceneUpdate", {"deletions": [], "entities": [entity]})
+
+
+def foxglove_scene(entities: Iterable[Mapping[str, Any]]) -> FoxgloveMessage:
+    """A foxglove.SceneUpdate of these entities (each replaces the one of the same id)."""
+    return FoxgloveMessage("foxglove.SceneUpdate", {"deletions": [], "entities": list(entities)})
+
+
+def _rgba(color_rgba: Sequence[float]) -> dict[str, float]:
+    r, g, b, a = (float(c) for c in color_rgba)
+    return {"r": r, "g": g, "b": b, "a": a}
+
+
+def scene_sphere(
+    center_n: Sequence[float], diameter_m: float, color_rgba: Sequence[float]
+) -> dict[str, Any]:
+    """A foxglove.SpherePrimitive centred at a NED point."""
+    return {
+        "pose": {"position": _vec3(center_n), "orientation": _quat_wxyz(_IDENTITY_Q)},
+        "size": _vec3((diameter_m, diameter_m, diameter_m)),
+        "color": _rgba(color_rgba),
+    }
+
+
+def scene_line_strip(
+    points_n: Iterable[Sequence[float]], thickness_m: float, color_rgba: Sequence[float]
+) -> dict[str, Any]:
+    """A foxglove.LinePrimitive through NED points, in order (type 0: line strip)."""
+    return {
+        "type": 0,
+        "pose": {"position": _vec3((0.0, 0.0, 0.0)), "orientation": _quat_wxyz(_IDENTITY_Q)},
+        "thickness": float(thickness_m),
+        "scale_invariant": False,
+        "points": [_vec3(p) for p in points_n],
+        "color": _rgba(color_rgba),
+        "colors": [],
+        "indices": [],
+    }
 
 
 def foxglove_grid(

@@ -29,7 +29,13 @@ from typing import Any
 
 from logs.encoding import schema_for_payload, to_jsonable
 from logs.errors import RecordingError
-from logs.foxglove import FoxgloveMessage, LogLevel, foxglove_log, ned_display_transform
+from logs.foxglove import (
+    FoxgloveMessage,
+    LogLevel,
+    foxglove_log,
+    ned_display_transform,
+    stamped,
+)
 from logs.mcap_sink import McapSink, schema_name_for_topic
 from logs.topics import LOG_TOPIC, MAVLINK_RX_TOPIC, MAVLINK_TX_TOPIC, TF_TOPIC
 
@@ -390,7 +396,7 @@ class Recorder:
     def _write_foxglove(self, topic: str, log_ns: int, message: FoxgloveMessage) -> None:
         if not self._sink.has_topic(topic):
             self._sink.add_well_known_topic(topic, message.schema_name)
-        self._sink.write(topic, log_ns, message.data, stamp=True)
+        self._sink.write(topic, log_ns, stamped(message, log_ns))
 
     def _write_record(self, topic: str, log_ns: int, payload: Any) -> None:
         if not (isinstance(payload, Mapping) or dataclasses.is_dataclass(payload)):
