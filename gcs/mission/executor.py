@@ -470,7 +470,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
             vehicle = session.vehicles[sysid]
             crafts[sysid] = Craft(sysid, vehicle.station)
             vehicle.station.start()
-        rec = _MultiRecording({s: session.vehicles[s].recorder for s in sysids})
+        rec = _MultiRecording({s: session.vehicles[s].sink for s in sysids})
         rec.scene(time.monotonic(), mw.world.room, mw.world.obstacles)
         f = _Flight(spec, crafts, rec, progress)
         try:

@@ -2,14 +2,22 @@
 
 Every payload is a plain dict (flat numbers where Foxglove's Plot panel should find them), or a
 Foxglove well-known message. A mission without a recorder (`--no-record`) writes nothing.
+
+For Foxglove's 3D panel each pose is also a `foxglove.FrameTransform` ned → `vehicle<N>_mission`
+(`/mission/tf`, per vehicle as `/v<N>/mission/tf` in a team), and each planner step's set
+positions become `/mission/setpoint` (a sphere per vehicle) and `/mission/path` (the line through
+every set position so far, at most `PATH_EVERY_S` apart in mission time, so a 400-step mission
+does not write 400 growing copies of its path).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from logs import SceneBox, foxglove_pose, foxglove_scene_from_boxes
+from logs import SceneBox, foxglove_pose, foxglove_scene_from_boxes, foxglove_transform
+from logs.foxglove import foxglove_scene, scene_entity, scene_line_strip, scene_sphere
 from planners.geometry import Box
 from planners.proximity import Facing, ProximityReading
 
@@ -23,6 +31,12 @@ MAP_VARIANCE = "/mission/radiation/log_variance"
 CONTOUR = "/mission/radiation/contour"
 SUMMARY = "/mission/summary"
 PROGRESS = "/mission/progress"
+POSE_TF = "/mission/tf"
+SETPOINT = "/mission/setpoint"
+PATH = "/mission/path"
+PATH_EVERY_S = 1.0
+SETPOINT_COLOR = (0.1, 0.8, 0.2, 0.8)
+PATH_COLOR = (1.0, 0.6, 0.1, 0.9)
 
 
 def vehicle_topic(topic: str, sysid: int | None) -> str:
@@ -45,16 +59,41 @@ class MissionRecording:
 
     def __init__(self, recorder: Any | None) -> None:
         self.recorder = recorder
+        self._paths: dict[int, list[tuple[float, float, float]]] = {}
+        self._next_path_s = -math.inf
+        self._last_z_n = 0.0
 
     @property
     def path(self) -> str | None:
         """The MCAP file, if recording."""
-        return str(self.recorder.path) if self.recorder is not None else None
+        path = getattr(self.recorder, "path", None)
+        return str(path) if path is not None else None
 
     def put(self, topic: str, t_s: float, payload: Any) -> None:
-        """Queue one message."""
-        if self.recorder is not None:
-            self.recorder.put(topic, t_s, payload)
+        """Queue one message (a planner step also updates the set point and the path)."""
+        if self.recorder is None:
+            return
+        self.recorder.put(topic, t_s, payload)
+        if topic in (STEP_EPBHA, STEP_FLOCK, SAMPLE_RADIATION) and isinstance(payload, dict):
+            self._planned(t_s, step_setpoints(topic, payload, self._last_z_n))
+
+    def _planned(self, t_s: float, setpoints: dict[int, tuple[float, float, float]]) -> None:
+        if not setpoints:
+            return
+        spheres = []
+        for sysid, p in setpoints.items():
+            trail = self._paths.setdefault(sysid, [])
+            if not trail or trail[-1] != p:
+                trail.append(p)
+            spheres.append(scene_entity(f"vehicle{sysid}_setpoint",
+                                        spheres=[scene_sphere(p, 0.12, SETPOINT_COLOR)]))
+        self.recorder.put(SETPOINT, t_s, foxglove_scene(spheres))
+        if t_s >= self._next_path_s:
+            self._next_path_s = t_s + PATH_EVERY_S
+            self.recorder.put(PATH, t_s, foxglove_scene(
+                scene_entity(f"vehicle{sysid}_path",
+                             lines=[scene_line_strip(trail, 0.03, PATH_COLOR)])
+                for sysid, trail in self._paths.items() if len(trail) >= 2))
 
     def scene(self, t_s: float, room: Box, boxes: Iterable[Box]) -> None:
         """The world's boxes as a foxglove.SceneUpdate (the room as a faint shell)."""
@@ -68,6 +107,25 @@ class MissionRecording:
         """A vehicle position as a foxglove.PoseInFrame."""
         if self.recorder is not None:
             self.put(vehicle_topic(POSE, sysid), t_s, foxglove_pose(pos_n))
+            self._last_z_n = float(pos_n[2])
+            frame = f"vehicle{1 if sysid is None else sysid}_mission"
+            self.put(vehicle_topic(POSE_TF, sysid), t_s, foxglove_transform("ned", frame, pos_n))
+
+
+def step_setpoints(topic: str, payload: dict[str, Any],
+                   z_n: float = 0.0) -> dict[int, tuple[float, float, float]]:
+    """The set positions (NED) a planner step asked for, by vehicle (1 for a single vehicle).
+
+    A radiation step is flat x/y (the mapper flies at one height): its set point takes `z_n`,
+    the height of the vehicle's last recorded pose.
+    """
+    if topic == STEP_EPBHA:
+        n = payload["decision"]["next"]
+        return {1: (n["x"], n["y"], n["z"])}
+    if topic == STEP_FLOCK:
+        return {int(v): (d["setpoint"]["x"], d["setpoint"]["y"], d["setpoint"]["z"])
+                for v, d in payload["vehicles"].items()}
+    return {1: (payload["next_x"], payload["next_y"], z_n)}
 
 
 def epbha_payload(step: int, pos_n: Sequence[float], reading: ProximityReading, decision: Any,

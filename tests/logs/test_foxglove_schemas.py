@@ -1,17 +1,25 @@
-"""Every schema a recording carries is one Foxglove's JSON Schema reader accepts."""
+"""Every schema a recording carries is one Foxglove's JSON Schema reader accepts, and every
+`foxglove.*` message of a real recording validates against Foxglove's official schema."""
 
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
+import pytest
 from mcap.reader import make_reader
 
+from gcs.foxglove_feed import POSE_ESTIMATE, POSE_MOCAP, SCENE_SETPOINT, SCENE_WORLD
+from gcs.mission.recording import PATH, POSE_TF, SCENE, SETPOINT
 from logs import Recorder
-from logs.foxglove import WELL_KNOWN_SCHEMAS
+from logs.foxglove import WELL_KNOWN_SCHEMAS, foxglove_scene_from_boxes, stamped
 from logs.recorder import RAW_FRAME_SCHEMA
 from tests.logs.foxglove_schema_check import foxglove_schema_problems
+from tests.logs.official_schemas import check_recording, problems, require_schemas
 
 
 def _schemas_in(path) -> dict[str, dict]:
@@ -63,3 +71,85 @@ def test_awkward_payloads_still_give_readable_schemas(tmp_path) -> None:
         rec.put("/dict", 1.0, {"none": None, "empty": [], "nested": {"deep": {}}, "ll": [[1]]})
     for name, schema in _schemas_in(rec.path).items():
         assert foxglove_schema_problems(schema) == [], name
+
+
+# Real recordings, validated message by message against Foxglove's official JSON Schemas.
+
+ROOT = Path(__file__).resolve().parents[2]
+MISSIONS = sorted((ROOT / "missions").glob("*.toml"))
+
+
+def _quadgcs(*argv: str, timeout_s: float = 240.0) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "gcs", *argv], capture_output=True, text=True,
+                          timeout=timeout_s, cwd=ROOT)
+
+
+@pytest.fixture(scope="module")
+def fly_recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A short `quadgcs fly` on the bundled SITL (sped up 2×), recorded to MCAP."""
+    require_schemas()
+    path = tmp_path_factory.mktemp("fly") / "fly.mcap"
+    proc = _quadgcs("fly", "--hold", "2", "--speedup", "2", "--seed", "4", "-o", str(path))
+    # 3: the flight itself went wrong (a loaded machine); its recording is still whole
+    assert proc.returncode in (0, 3), proc.stderr[-2000:]
+    assert path.is_file(), proc.stderr[-2000:]
+    return path
+
+
+def _messages(path: Path, topic: str) -> list[tuple[int, dict]]:
+    with open(path, "rb") as f:
+        return [(m.log_time, json.loads(m.data)) for _, _, m in
+                make_reader(f).iter_messages(topics=[topic], log_time_order=False)]
+
+
+@pytest.mark.e2e
+def test_fly_recording_validates_and_moves(fly_recording: Path) -> None:
+    counts = check_recording(fly_recording)
+    for topic in ("/tf", POSE_ESTIMATE, POSE_MOCAP, SCENE_WORLD, SCENE_SETPOINT):
+        assert counts[topic] > 0, (topic, counts)
+    estimate = _messages(fly_recording, POSE_ESTIMATE)
+    assert {m["child_frame_id"] for _, m in estimate} == {"vehicle1_estimate"}
+    assert {m["parent_frame_id"] for _, m in estimate} == {"ned"}
+    # the vehicle climbs to its 1 m hold: the estimate's frame goes up (NED z negative)
+    assert min(m["translation"]["z"] for _, m in estimate) < -0.7
+    mocap = _messages(fly_recording, POSE_MOCAP)
+    assert {m["child_frame_id"] for _, m in mocap} == {"vehicle1_mocap"}
+    assert min(m["translation"]["z"] for _, m in mocap) < -0.7
+    # rate-limited: at most ~15 a second of flight time, however fast the loop ran
+    for series in (estimate, mocap):
+        times = sorted(t for t, _ in series)
+        span_s = (times[-1] - times[0]) / 1e9
+        assert span_s > 2.0
+        assert 8.0 <= (len(times) - 1) / span_s <= 20.0
+    world = _messages(fly_recording, SCENE_WORLD)[0][1]
+    assert [c["size"] for c in world["entities"][0]["cubes"]] == [{"x": 6.0, "y": 6.0, "z": 3.0}]
+
+
+@pytest.mark.parametrize("mission", MISSIONS, ids=[m.stem for m in MISSIONS])
+def test_kinematic_mission_recordings_validate(mission: Path, tmp_path: Path) -> None:
+    require_schemas()
+    path = tmp_path / f"{mission.stem}.mcap"
+    proc = _quadgcs("mission", "run", str(mission), "--kinematic", "-q", "--seed", "1",
+                    "-o", str(path), "--plot", str(tmp_path / "plot.png"))
+    assert proc.returncode in (0, 3), proc.stderr[-2000:]
+    counts = check_recording(path)
+    for topic in (SCENE, SETPOINT, PATH):
+        assert counts[topic] > 0, (topic, counts)
+    assert any(t.endswith(POSE_TF) for t in counts), counts
+    path_msgs = _messages(path, PATH)
+    last_lines = [e["lines"][0]["points"] for e in path_msgs[-1][1]["entities"]]
+    assert last_lines and all(len(points) >= 2 for points in last_lines)
+
+
+def test_replay_writes_no_recording_to_check() -> None:
+    """`replay` plays a file back (screens, headless or live) and writes none of its own: the
+    recordings above are every kind of file the project writes with foxglove.* messages."""
+    help_text = _quadgcs("replay", "--help", timeout_s=60).stdout
+    assert "--output" not in help_text and " -o " not in help_text
+
+
+def test_the_official_schemas_refuse_the_old_scene() -> None:
+    old = foxglove_scene_from_boxes([((0, 0, -1), (1, 1, 0))]).data
+    assert problems("foxglove.SceneUpdate", old)  # no entity timestamps
+    assert problems("foxglove.SceneUpdate", stamped(foxglove_scene_from_boxes(
+        [((0, 0, -1), (1, 1, 0))]), 10**18)) == []
