@@ -10,6 +10,7 @@ happens in between: overrides released, links closed, files finished, the SITL s
 from __future__ import annotations
 
 import contextlib
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,7 @@ from firmware_link.truth_link import TruthLink, TruthRecorder
 from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import load_config
 from gcs.errors import UsageError
+from gcs.foxglove_feed import DEFAULT_WORLD, FoxgloveFeed, open_live, world_boxes
 from gcs.preflight import PreflightReport, read_and_check
 from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlOptions, SitlProcess
@@ -54,6 +56,7 @@ class SessionOptions:
     spin_s: float = 0.0015
     metadata: dict[str, Any] = field(default_factory=dict)
     fix_failsafe: bool = False  # the pilot's consent to set unsafe failsafe parameters
+    foxglove: str | None = None  # [HOST:]PORT: serve the flight live to Foxglove
 
     def validate(self) -> None:
         """Reject impossible combinations with one line each."""
@@ -86,6 +89,8 @@ class Vehicle:
     link: VehicleLink
     station: Station
     recorder: Any | None
+    # what the station records into: the recorder plus the 3D view's topics and the live view
+    sink: Any | None = None
     # the bundled SITL's ground truth, for scoring only: nothing that flies reads it
     truth: TruthRecorder | None = None
 
@@ -112,6 +117,7 @@ class StationSession:
         self.vehicles: dict[int, Vehicle] = {}
         self.sitl_endpoints: Any = None
         self.preflight: dict[int, PreflightReport] = {}
+        self.live: Any = None  # logs.live.LiveView with --foxglove
         self._stack = contextlib.ExitStack()
 
     def __enter__(self) -> StationSession:
@@ -171,6 +177,11 @@ class StationSession:
             mocap_url = mocap_url or self.sitl_endpoints.mocap
         else:
             urls = {o.sysids[0]: o.connect}
+        if o.foxglove is not None:
+            self.live = open_live(o.foxglove)
+            self._stack.callback(self.live.close)
+            if o.command != "teleop":  # teleop's screen owns the terminal
+                print(f"foxglove: live view on {self.live.url}", file=sys.stderr, flush=True)
         for sysid, url in urls.items():
             self.vehicles[sysid] = self._open_vehicle(sysid, url, mocap_url, key, config)
         truth_url = getattr(self.sitl_endpoints, "truth", None)
@@ -193,9 +204,14 @@ class StationSession:
             except RecordingError as exc:
                 raise UsageError(f"-o {o.output}: {exc}") from None
             self._stack.callback(recorder.close)
+        sink = None
+        if recorder is not None or self.live is not None:
+            world = o.world if o.world is not None or o.connect is not None else DEFAULT_WORLD
+            sink = FoxgloveFeed(recorder, self.live, sysid=sysid, boxes=world_boxes(world),
+                                live_prefix=f"/v{sysid}" if len(o.sysids) > 1 else "")
         link = VehicleLink.open(url, signing_key=key, clock=self.clock.now_s,
                                 target_system=sysid if o.connect is None else None,
-                                on_raw=recorder.put_raw if recorder is not None else None)
+                                on_raw=sink.put_raw if sink is not None else None)
         self._stack.callback(link.close)
         link.bring_up(STREAM_RATE_HZ)
         # The throttle curve is how the station turns a thrust into a stick: a default in place
@@ -212,11 +228,12 @@ class StationSession:
             mocap_link = MocapLink.open(mocap_url, clock=self.clock.now_s)
             self._stack.callback(mocap_link.close)
             mocap = MocapFor(mocap_link, sysid)
-        station = Station(link, config=config, curve=curve, mocap=mocap, recorder=recorder,
+        station = Station(link, config=config, curve=curve, mocap=mocap, recorder=sink,
                           clock=self.clock)
         report = self._preflight(link)
         self.preflight[sysid] = report
         station.preflight(report.ok, report.summary())
         # registered last, so it stops first: the loop releases overrides before links close
         self._stack.callback(station.stop)
-        return Vehicle(sysid=sysid, url=url, link=link, station=station, recorder=recorder)
+        return Vehicle(sysid=sysid, url=url, link=link, station=station, recorder=recorder,
+                       sink=sink)

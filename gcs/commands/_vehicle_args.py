@@ -30,6 +30,15 @@ def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
                    help="let the station set the vehicle's GCS failsafe parameters when the "
                         "pre-flight checks find them unsafe (FS_GCS_ENABLE, FS_GCS_TIMEOUT); "
                         "without it such a vehicle is refused")
+    add_foxglove_argument(p)
+
+
+def add_foxglove_argument(p: argparse.ArgumentParser) -> None:
+    """--foxglove [HOST:]PORT: the live view (fly, teleop, mission run, replay)."""
+    p.add_argument("--foxglove", metavar="[HOST:]PORT",
+                   help="serve the flight live to Foxglove over its WebSocket protocol "
+                        "(ws://HOST:PORT, the recording's topics); HOST defaults to 127.0.0.1, "
+                        "use 0.0.0.0 to serve other machines; port 0 picks a free one")
 
 
 def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
@@ -39,4 +48,5 @@ def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
         world=args.world, serial=args.serial, speedup=getattr(args, "speedup", 1.0),
         seed=args.seed, config=args.config, signing_key=args.signing_key, record=args.record,
         output=args.output, fix_failsafe=getattr(args, "fix_failsafe", False),
+        foxglove=getattr(args, "foxglove", None),
     )
