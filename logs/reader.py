@@ -154,6 +154,14 @@ class Recording:
             )
         return dict(sorted(out.items()))
 
+    def schema(self, topic: str) -> tuple[str, bytes]:
+        """A topic's schema name and text as recorded (("", b"") for a schemaless topic)."""
+        for channel in self._channels.values():
+            if channel.topic == topic:
+                schema = self._schemas.get(channel.schema_id)
+                return (schema.name, bytes(schema.data)) if schema else ("", b"")
+        raise RecordingError(f"{self.path}: no topic {topic!r}")
+
     @property
     def metadata(self) -> dict[str, Any]:
         """The flight's metadata (vehicle, software version, parameters, world/mission text…)."""

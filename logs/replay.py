@@ -177,8 +177,10 @@ def run_headless(
     as_fast_as_possible: bool = False,
     sleep: Callable[[float], None] = time.sleep,
     max_wait_s: float = 0.25,
+    on_message: Callable[[ReplayMessage], None] | None = None,
 ) -> ReplayReport:
-    """Play to the end, printing one status line per recorded second (and one at the end)."""
+    """Play to the end, printing one status line per recorded second (and one at the end);
+    `on_message` sees every message as it is played (the live view)."""
     tracker = SignalTracker()
     next_line_s = 1.0
     lines = 0
@@ -192,6 +194,8 @@ def run_headless(
                 lines += 1
                 next_line_s += 1.0
             tracker.update(msg.topic, msg.message)
+            if on_message is not None:
+                on_message(msg)
             played += 1
 
     if as_fast_as_possible:

@@ -12,9 +12,10 @@ import json
 import sys
 from pathlib import Path
 
+from gcs.commands._vehicle_args import add_foxglove_argument
 from gcs.errors import UsageError
 from logs import RecordingError, open_recording
-from logs.replay import Player, run_headless
+from logs.replay import Player, ReplayMessage, run_headless
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -36,6 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              "station-config keys; alt. = altitude.gains., est. = estimator., "
                              "pos. = position.) or a station-config TOML file; repeatable")
     parser.add_argument("--json", action="store_true", help="with --rerun: one JSON object")
+    add_foxglove_argument(parser)
     parser.set_defaults(func=run_replay)
 
 
@@ -45,6 +47,8 @@ def run_replay(args: argparse.Namespace) -> int:
         return run_rerun(args)
     if args.gains or args.json:
         raise UsageError("--gains and --json go with --rerun")
+    if args.foxglove is not None:
+        return run_live(args)
     try:
         recording = open_recording(args.file)
         player = Player(recording, speed=args.speed)
@@ -53,6 +57,33 @@ def run_replay(args: argparse.Namespace) -> int:
     if not (args.headless or args.max) and sys.stdout.isatty():
         return run_screens(player, args.file, recording.metadata)
     report = run_headless(player, sys.stdout, as_fast_as_possible=args.max)
+    print(f"replayed {report.messages} messages, {report.duration_s:.1f} s of flight")
+    return 0
+
+
+def run_live(args: argparse.Namespace) -> int:
+    """Play the recording on its timeline (headless) and serve every message to Foxglove with
+    its recorded schema and log time, as the flight itself served them."""
+    from gcs.foxglove_feed import open_live
+    from logs.encoding import encode_json
+
+    try:
+        recording = open_recording(args.file)
+        player = Player(recording, speed=args.speed)
+    except RecordingError as exc:
+        raise UsageError(str(exc)) from exc
+    schemas = {topic: recording.schema(topic) for topic in recording.topics}
+    live = open_live(args.foxglove)
+    print(f"foxglove: live view on {live.url}", file=sys.stderr, flush=True)
+    try:
+        def publish(msg: ReplayMessage) -> None:
+            name, schema = schemas[msg.topic]
+            live.publish(msg.topic, name, schema, msg.log_time_ns, encode_json(msg.message))
+
+        report = run_headless(player, sys.stdout, as_fast_as_possible=args.max,
+                              on_message=publish)
+    finally:
+        live.close()
     print(f"replayed {report.messages} messages, {report.duration_s:.1f} s of flight")
     return 0
 

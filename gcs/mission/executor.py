@@ -462,6 +462,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         command="mission", connect=options.connect, mocap=options.mocap, profile=spec.profile,
         world=spec.world_path, speedup=speedup, seed=options.seed, record=options.record,
         output=options.output, sysids=sysids, fix_failsafe=options.fix_failsafe,
+        foxglove=getattr(options, "foxglove", None),
         metadata={"mission": spec.name, "planner": spec.planner.value,
                   "mission_file": str(spec.path)})
     with StationSession(session_options) as session:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -17,7 +18,7 @@ from gcs.mission.kinematic import (
     run_radiation_kinematic,
 )
 from gcs.mission.planner_params import planner_setup
-from gcs.mission.recording import SUMMARY, MissionRecording
+from gcs.mission.recording import SUMMARY, LiveTee, MissionRecording
 from gcs.mission.report import MissionReport
 from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.world import MissionWorld, load_world
@@ -36,6 +37,7 @@ class RunOptions:
     speedup: float | None = None  # None: the mission file's
     seed: int | None = None
     fix_failsafe: bool = False  # the pilot's consent to set unsafe GCS-failsafe parameters
+    foxglove: str | None = None  # [HOST:]PORT: serve the mission live to Foxglove
 
 
 def mission_world(spec: MissionSpec) -> MissionWorld:
@@ -71,7 +73,14 @@ def run_mission(spec: MissionSpec, options: RunOptions,
         recorder = _open_recorder(spec, options, "kinematic") if options.record else None
         if recorder is not None:
             stack.callback(recorder.close)
-        rec = MissionRecording(recorder)
+        live = None
+        if options.foxglove is not None:
+            from gcs.foxglove_feed import open_live
+
+            live = open_live(options.foxglove)
+            stack.callback(live.close)
+            print(f"foxglove: live view on {live.url}", file=sys.stderr, flush=True)
+        rec = MissionRecording(LiveTee(recorder, live) if live is not None else recorder)
         products: Any = None
         if spec.planner is PlannerKind.EPBHA:
             report = run_epbha_kinematic(spec, mw, setup, rec, progress)

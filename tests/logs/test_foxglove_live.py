@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from gcs.foxglove_feed import POSE_ESTIMATE, POSE_MOCAP
-from logs import RecordingError
+from logs import RecordingError, open_recording
 from logs.foxglove import foxglove_transform
 from logs.live import LiveView, parse_address
 from tests.logs.foxglove_client import SUBPROTOCOL, FoxgloveClient, Received
@@ -148,3 +148,36 @@ def test_addresses_and_a_busy_port() -> None:
         s.listen()
         with pytest.raises(RecordingError, match="cannot serve"):
             LiveView("127.0.0.1", s.getsockname()[1])
+
+
+@pytest.mark.e2e
+def test_live_replay_serves_the_recording(recorded_flight: tuple[Path, dict[str, int]]) -> None:
+    path, counts = recorded_flight
+    recording = open_recording(path)
+    topics = {t for t, n in counts.items() if n > 0 and t.startswith("/gcs")}
+    assert topics
+    expected = {t: [(log_ns, msg) for _, log_ns, msg in recording.messages([t])] for t in topics}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "gcs", "replay", str(path), "--headless", "--speed", "2",
+         "--foxglove", "127.0.0.1:0"],
+        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    err = StderrLines(proc)
+    try:
+        m = err.wait_for(URL_LINE, 60.0)
+        assert m, "".join(err.lines)[-2000:]
+
+        async def watch() -> Received:
+            async with FoxgloveClient(m.group(1), topics) as c:
+                # until the replay ends and the server closes the connection
+                await c.run_until(lambda r: False, 60.0)
+                return c.received
+
+        received = asyncio.run(watch())
+    finally:
+        proc.wait(timeout=60)
+    assert proc.returncode == 0, "".join(err.lines)[-2000:]
+    assert received.by_topic.keys() == topics
+    for topic, series in received.by_topic.items():
+        # subscribed a moment after the replay started: a tail of the recording, exactly
+        assert len(series) > len(expected[topic]) // 2, topic
+        assert series == expected[topic][-len(series):], topic
