@@ -49,10 +49,11 @@ RENAMED = {
 }
 
 
-def _add_vehicle_flags(p: argparse.ArgumentParser, default: object) -> None:
-    """The vehicle flags; on the actions with SUPPRESS so they may also follow the action."""
+def _add_vehicle_flags(p: argparse.ArgumentParser, *, on_action: bool) -> None:
+    """The vehicle flags. Pilots type them before or after the action, so the actions take
+    them too, with suppressed defaults that never overwrite the ones given before."""
     def d(value: object) -> object:
-        return value if default is None else default
+        return argparse.SUPPRESS if on_action else value
 
     p.add_argument("--connect", metavar="URL", default=d(None),
                    help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
@@ -71,7 +72,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the `params` subcommand and its actions."""
     p = sub.add_parser("params", help="show, get, set, save, load or diff vehicle parameters",
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    _add_vehicle_flags(p, None)
+    _add_vehicle_flags(p, on_action=False)
     actions = p.add_subparsers(dest="action", metavar="ACTION")
     specs: tuple[tuple[str, str, Callable[[argparse.ArgumentParser], None]], ...] = (
         ("show", "list parameters (NAME VALUE, sorted)", lambda a: a.add_argument(
@@ -89,7 +90,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     for name, helptext, add in specs:
         a = actions.add_parser(name, help=helptext)
         add(a)
-        _add_vehicle_flags(a, argparse.SUPPRESS)
+        _add_vehicle_flags(a, on_action=True)
     p.set_defaults(func=run, action=None)
 
 
