@@ -18,7 +18,7 @@ Prints numbers; asserts nothing.
 
     .venv/bin/python bench/faults.py [--speedup K] [--profile apm25|copter4|both]
                                      [--case downlink ...] [--serial] [--seed N]
-                                     [--record DIR]
+                                     [--repeat N] [--record DIR]
 """
 
 from __future__ import annotations
@@ -88,6 +88,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--serial", action="store_true",
                     help="also fly both-ways loss over the serial pty (apm25)")
     ap.add_argument("--seed", type=int, default=3, help="SITL noise and fault seed (default 3)")
+    ap.add_argument("--repeat", type=int, default=1, metavar="N",
+                    help="fly every case N times, seeds SEED..SEED+N-1: where the outcome "
+                         "hangs on the last command the vehicle got, one flight is one draw")
     ap.add_argument("--record", type=Path, metavar="DIR",
                     help="keep fly's MCAP recording of each flight in DIR (default none)")
     args = ap.parse_args(argv)
@@ -95,30 +98,38 @@ def main(argv: list[str] | None = None) -> int:
         print(f"bench/faults.py: --speedup {args.speedup}: expected 0 < K <= 50",
               file=sys.stderr)
         return 2
+    if args.repeat < 1:
+        print(f"bench/faults.py: --repeat {args.repeat}: expected N >= 1", file=sys.stderr)
+        return 2
     profiles = ("apm25", "copter4") if args.profile == "both" else (args.profile,)
     specs = [FlightSpec(c, p) for c in (args.case or list(CASES)) for p in profiles]
     if args.serial:
         specs.append(FlightSpec("both", "apm25", "serial"))
     note = "" if speedup_allowed() else (" (fly refuses --speedup with --connect: real time, "
                                          "three flights at a time)")
-    print(f"bench/faults.py  seed={args.seed} flights={len(specs)}{note}", flush=True)
+    seeds = range(args.seed, args.seed + args.repeat)
+    print(f"bench/faults.py  seeds={list(seeds)} flights={len(specs) * args.repeat}{note}",
+          flush=True)
     t0 = time.monotonic()
-    if args.record is not None:
-        args.record.mkdir(parents=True, exist_ok=True)
-    results = run_many(specs, seed=args.seed, speedup=args.speedup, record_dir=args.record)
+    results = {seed: run_many(specs, seed=seed, speedup=args.speedup,
+                              record_dir=None if args.record is None
+                              else args.record / f"seed{seed}")
+               for seed in seeds}
     print(f"\n{'fault':15s} {'profile':8s} {'documented response':66s} {'over set':>9s} "
           f"{'touch m/s':>9s} {'disarm s':>9s} {'exit':>5s}")
+    speeds = set()
     for spec in specs:
-        r = results[spec]
-        if isinstance(r, Exception):
-            print(f"{spec.case:15s} {spec.profile:8s} not flown: {type(r).__name__}: {r}")
-            continue
-        print(row(r))
-        print(details(r))
-    speeds = sorted({f"{r.speedup:g}x" for r in results.values()
-                     if isinstance(r, FlightResult)})
-    print(f"\n{len(specs)} flights at {', '.join(speeds)} in {time.monotonic() - t0:.0f} s of "
-          "wall time; heights from motion capture, 'over set' = highest height - 1.0 m")
+        for seed in seeds:
+            r = results[seed][spec]
+            if isinstance(r, Exception):
+                print(f"{spec.case:15s} {spec.profile:8s} not flown: {type(r).__name__}: {r}")
+                continue
+            speeds.add(f"{r.speedup:g}x")
+            print(row(r) + (f"  seed {seed}" if args.repeat > 1 else ""))
+            print(details(r))
+    print(f"\n{len(specs) * args.repeat} flights at {', '.join(sorted(speeds))} in "
+          f"{time.monotonic() - t0:.0f} s of wall time; heights from motion capture, 'over set'"
+          " = highest height - 1.0 m")
     return 0
 
 
