@@ -47,8 +47,11 @@ from gcs.altitude_controller import AltitudeController
 from gcs.clock import Clock, MonotonicClock
 from gcs.config import StationConfig
 from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
-from gcs.loop import FixedRateLoop, TickTiming
-from gcs.position_controller import PositionController, PositionSetpoint
+from gcs.loop import FixedRateLoop
+from gcs.position_controller import PositionController
+from gcs.station_exit import emergency_land, let_go
+from gcs.station_intents import STICK_MAX_US, STICK_MIN_US, StationIntents
+from gcs.station_record import TickRecord, average_imu, record_tick
 from gcs.station_types import (
     NEVER_S,
     ControlMode,
@@ -89,7 +92,6 @@ __all__ = [
     "control_mode",
 ]
 
-STICK_MIN_US, STICK_MAX_US = 1000, 2000
 LAND_WAIT_STATES = frozenset({SupervisorState.RELEASED, SupervisorState.DISARMED,
                               SupervisorState.SILENT, SupervisorState.LINK_LOST})
 """A stopping station may leave once the supervisor is in one of these."""
@@ -129,7 +131,7 @@ def control_mode(state: SupervisorState, position: bool) -> ControlMode:
     return ControlMode.MANUAL
 
 
-class Station:
+class Station(StationIntents):
     """Owns the link and the control stack; runs the loop on its own thread."""
 
     def __init__(
@@ -257,91 +259,20 @@ class Station:
 
     def _let_go(self) -> None:
         """Release the overrides only where that cannot drop a flying vehicle."""
-        state = self.supervisor.state
         hb = self._latest.get(Heartbeat)
-        disarmed = isinstance(hb, Heartbeat) and not hb.armed
-        landing = isinstance(hb, Heartbeat) and hb.mode == FlightMode.LAND
-        if state in (SupervisorState.RELEASED, SupervisorState.DISARMED) or disarmed or landing:
-            try:
-                self.link.release_overrides()
-            except Exception as exc:  # the link may be what failed; the vehicle's failsafe rules
-                self._event(self.clock.now_s(), EventLevel.ERROR,
-                            f"could not release overrides: {exc}")
-        elif state is not SupervisorState.SILENT:
-            self._event(self.clock.now_s(), EventLevel.ERROR,
-                        f"left the vehicle armed in {state.value}: overrides not released, the "
-                        "vehicle's own failsafe takes over")
+        text = let_go(self.link, self.supervisor.state, hb if isinstance(hb, Heartbeat) else None)
+        if text:
+            self._event(self.clock.now_s(), EventLevel.ERROR, text)
 
-    def _emergency_land(self, seconds: float = 3.0) -> None:
+    def _emergency_land(self) -> None:
         """The loop crashed: ask for LAND (hover throttle, level) until a heartbeat shows it."""
         if self.supervisor.state not in AIRBORNE_CAPABLE:
             return
-        hover = RcCommand(1500, 1500, self.alt_ctrl.hover_stick_us(), 1500)
-        end = time.monotonic() + seconds
-        next_mode = 0.0
-        try:
-            while time.monotonic() < end:
-                for r in self.link.poll():
-                    if isinstance(r, Heartbeat):
-                        self._latest[Heartbeat] = r
-                hb = self._latest.get(Heartbeat)
-                if isinstance(hb, Heartbeat) and (not hb.armed or hb.mode == FlightMode.LAND):
-                    return
-                if time.monotonic() >= next_mode:
-                    self.link.send_set_mode(FlightMode.LAND)
-                    next_mode = time.monotonic() + 0.5
-                self.link.rc_override(hover)
-                time.sleep(self.config.period_s)  # a dead loop paces itself: no clock to wait on
-        except Exception as exc:
-            self._event(self.clock.now_s(), EventLevel.ERROR, f"emergency LAND failed: {exc}")
-
-    # ------------------------------------------------------------------ intents (any thread)
-    def _intent(self, intent: Intent) -> None:
-        self._intents.put(intent)
-
-    def request_arm(self, force: bool = False) -> None:
-        """Ask the vehicle to arm (refused by the supervisor until pre-flight checks pass)."""
-        self._intent(Intent(IntentKind.ARM))
-
-    def request_disarm(self, force: bool = False) -> None:
-        """Ask the vehicle to disarm."""
-        self._intent(Intent(IntentKind.DISARM))
-
-    def set_mode(self, mode: FlightMode) -> None:
-        """Ask the vehicle for a flight mode (SET_MODE)."""
-        self._intent(Intent(IntentKind.SET_MODE, mode=int(mode)))
-
-    def set_sticks(self, roll_us: int, pitch_us: int, yaw_us: int, throttle_us: int) -> None:
-        """Teleop sticks (µs); the throttle is used only under the pilot's control."""
-        self._intent(Intent(IntentKind.STICKS, roll_us=_clamp_us(roll_us),
-                            pitch_us=_clamp_us(pitch_us), throttle_us=_clamp_us(throttle_us),
-                            yaw_us=_clamp_us(yaw_us)))
-
-    def alt_hold(self, on: bool, setpoint_m: float | None = None,
-                 rate_mps: float | None = None) -> None:
-        """Engage PC altitude hold (taking off if on the floor) or leave it. The setpoint moves
-        to `setpoint_m` at `rate_mps` (None: the controller's own profile); None keeps the
-        present altitude."""
-        self._intent(Intent(IntentKind.ALT_HOLD, setpoint_m=setpoint_m, rate_mps=rate_mps)
-                     if on else Intent(IntentKind.ALT_HOLD_OFF))
-
-    def set_position_setpoint(self, setpoint: PositionSetpoint | None) -> None:
-        """Hold a mocap position while the altitude is held; None: level sticks from the pilot."""
-        self._intent(Intent(IntentKind.POSITION_OFF) if setpoint is None else Intent(
-            IntentKind.POSITION, north_m=setpoint.north_m, east_m=setpoint.east_m,
-            yaw_rad=setpoint.yaw_rad))
-
-    def kill(self) -> None:
-        """Throttle to minimum from the next tick and disarm until a heartbeat says disarmed."""
-        self._intent(Intent(IntentKind.KILL))
-
-    def quit(self) -> None:
-        """Land if flying (LAND confirmed by a heartbeat), then release the overrides."""
-        self._intent(Intent(IntentKind.QUIT))
-
-    def preflight(self, ok: bool, note: str) -> None:
-        """The pre-flight checks' verdict: arming is refused until one says ok."""
-        self._intent(Intent(IntentKind.PREFLIGHT, ok=ok, note=note))
+        hb = emergency_land(self.link, self.alt_ctrl.hover_stick_us(), self.config.period_s)
+        if isinstance(hb, Heartbeat):
+            self._latest[Heartbeat] = hb
+        elif hb:
+            self._event(self.clock.now_s(), EventLevel.ERROR, f"emergency LAND failed: {hb}")
 
     # ------------------------------------------------------------------ reading (any thread)
     def snapshot(self, loop_stats: bool = True) -> StationSnapshot:
@@ -494,38 +425,10 @@ class Station:
     def _record_tick(self, t_s: float, k: int, dt_s: float, est: AltEstimate,
                      records: list[TelemetryRecord], intents: list[Intent],
                      status: VehicleStatus, out: SupervisorOutput, at_rest: bool) -> None:
-        rec = self.recorder
-        if rec is None:
-            return
-        for it in intents:
-            rec.put(topics.INTENT, t_s, it)
-        rec.put(topics.TICK, t_s, TickInputs(
-            tick=k, t_s=t_s, dt_s=dt_s,
-            imu_n=sum(isinstance(r, Imu) for r in records),
-            rangefinder_n=sum(isinstance(r, Rangefinder) for r in records),
-            attitude_n=sum(isinstance(r, Attitude) for r in records),
-            mocap_n=sum(isinstance(r, MocapPose) for r in records),
-            baro_n=sum(isinstance(r, Barometer) for r in records),
-            intent_n=len(intents), at_rest=at_rest, vehicle_seen=status.seen,
-            armed=status.armed, vehicle_mode=status.mode, heartbeat_t_s=status.heartbeat_t_s,
-            frame_age_s=status.frame_age_s, state=out.state,
-            link_lost=out.link is LinkHealth.LOST))
-        for tr in out.transitions:
-            rec.put(topics.SUPERVISOR, t_s, tr)
-        rec.put(topics.ESTIMATE, t_s, est)
-        sup = self.supervisor
-        if sup.alt is not None:
-            rec.put(topics.ALT_CONTROLLER, t_s, sup.alt)
-        if sup.position is not None:
-            rec.put(topics.POSITION_CONTROLLER, t_s, sup.position)
-        if out.command is not None:
-            rec.put(topics.RC_OVERRIDE, t_s, out.command)
-        last: TickTiming | None = self.loop.last_timing
-        if last is not None:
-            rec.put(topics.LOOP, t_s, LoopSample(
-                tick=last.k, period_ms=last.period_s * 1e3, jitter_ms=last.jitter_s * 1e3,
-                lateness_ms=last.lateness_s * 1e3, compute_ms=last.compute_s * 1e3,
-                overrun=last.overrun))
+        if self.recorder is not None:
+            record_tick(self.recorder, TickRecord(
+                t_s, k, dt_s, est, records, intents, status, out, at_rest, self.supervisor.alt,
+                self.supervisor.position, self.loop.last_timing))
 
     def _make_snapshot(self, t_s: float, k: int) -> StationSnapshot:
         sup = self.supervisor
@@ -570,17 +473,3 @@ class Station:
             listener_errors=self._listener_errors,
             link_down_s=self._link_down_s,
         )
-
-
-def average_imu(imus: list[Imu]) -> Imu | None:
-    """One tick's IMU samples averaged: less vibration noise, same information (None if none)."""
-    if not imus:
-        return None
-    n = len(imus)
-    acc = tuple(sum(i.acc_b[a] for i in imus) / n for a in range(3))
-    last = imus[-1]
-    return Imu(last.t_s, last.sysid, acc, last.gyro_b, last.source, last.time_usec)
-
-
-def _clamp_us(v: int) -> int:
-    return max(STICK_MIN_US, min(STICK_MAX_US, int(v)))
