@@ -319,6 +319,7 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
     if transport == "serial":
         args.append("--serial")
     with contextlib.ExitStack() as stack:
+        stack.callback(udp.close)
         sitl = stack.enter_context(_sitl(args))
         watch_udp = MavWatcher(udp, udp=True)
         stack.callback(watch_udp.close)
