@@ -77,6 +77,7 @@ class PadStatus:
     throttle_axis: float = 0.0
     throttle_us: int = THROTTLE_MIN_US
     note: str = ""
+    buttons: frozenset[str] = frozenset()  # roles held down
 
 
 def shape(value: float, deadzone: float, expo: float) -> float:
@@ -145,9 +146,10 @@ class GamepadPilot:
             else:
                 self._started = True
                 out += self._unmanned(t_s, vehicle)
-                why = ("throttle ok" if neutral else "centre the throttle" if held_altitude
-                       else "throttle to minimum")
-                self._show(roll, pitch, yaw, thr_axis, f"{why}, then press a button")
+                note = ("throttle ok: press a button" if neutral
+                        else "throttle to centre, then a button" if held_altitude
+                        else "throttle down, then a button")
+                self._show(roll, pitch, yaw, thr_axis, note, sample.buttons)
                 return out
         self._started = True
         out += self._buttons(pressed, vehicle)
@@ -165,7 +167,7 @@ class GamepadPilot:
             self._accum_us = THROTTLE_MIN_US
         self._sent_us = throttle_us
         out.append(intents.Sticks(roll=roll, pitch=pitch, yaw=yaw, throttle_us=throttle_us))
-        self._show(roll, pitch, yaw, thr_axis, "")
+        self._show(roll, pitch, yaw, thr_axis, "", sample.buttons)
         return out
 
     # ------------------------------------------------------------------ helpers
@@ -227,7 +229,8 @@ class GamepadPilot:
         out.append(intents.Sticks(roll=0.0, pitch=0.0, yaw=0.0, throttle_us=self._sent_us))
         return out
 
-    def _show(self, roll: float, pitch: float, yaw: float, thr_axis: float, note: str) -> None:
+    def _show(self, roll: float, pitch: float, yaw: float, thr_axis: float, note: str,
+              buttons: frozenset[str] = frozenset()) -> None:
         if self.phase is PadPhase.UNPLUGGED:
             if self._land_sent_s is not None:
                 note = "unplugged: LAND commanded"
@@ -239,4 +242,5 @@ class GamepadPilot:
         elif self._land_sent_s is not None:
             note = f"LAND commanded; {note}"
         self.status = PadStatus(phase=self.phase, roll=roll, pitch=pitch, yaw=yaw,
-                                throttle_axis=thr_axis, throttle_us=self._sent_us, note=note)
+                                throttle_axis=thr_axis, throttle_us=self._sent_us, note=note,
+                                buttons=buttons)

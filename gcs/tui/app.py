@@ -17,9 +17,11 @@ from textual.binding import Binding
 from textual.containers import Horizontal
 from textual.widgets import Footer, RichLog
 
+from gcs.gamepad.driver import Gamepad
 from gcs.tui import intents
 from gcs.tui.backend import TeleopBackend
 from gcs.tui.help import ConfirmQuit, HelpScreen, describe
+from gcs.tui.pad_panel import PadPanel
 from gcs.tui.sticks import Sticks
 from gcs.tui.view import TeleopView
 from gcs.tui.widgets import AccelPlot, AltitudePanel, HeightPlot, LinkPanel, VehiclePanel
@@ -75,8 +77,10 @@ class TeleopApp(App[None]):
         *,
         clock: Callable[[], float] = time.monotonic,
         redraw_timers: bool = True,
+        gamepad: Gamepad | None = None,
     ) -> None:
         super().__init__()
+        self.gamepad = gamepad  # when set, the pad owns the sticks (the keyboard's are off)
         self.redraw_timers = redraw_timers  # False: draw once (screenshots of a fixed view)
         self.backend = backend
         self._clock = clock
@@ -95,6 +99,8 @@ class TeleopApp(App[None]):
         with Horizontal(id="plots"):
             yield HeightPlot(id="height-plot")
             yield AccelPlot(id="accel-plot")
+        if self.gamepad is not None:
+            yield PadPanel(id="pad")
         log = RichLog(id="messages", max_lines=500, wrap=False, markup=False)
         log.can_focus = False  # arrow keys are sticks, never scrolling
         yield log
@@ -108,16 +114,21 @@ class TeleopApp(App[None]):
         self.query_one("#messages").border_title = "messages"
         self.redraw()
         self.redraw_plots()
+        self._show_pad()
         if not self.redraw_timers:
             return
         self.set_interval(1.0 / REDRAW_HZ, self.redraw)
         self.set_interval(1.0 / PLOT_HZ, self.redraw_plots)
-        if self.backend.live:
+        if self.backend.live and self.gamepad is not None:
+            self.set_interval(1.0 / self.gamepad.poll_hz, self.poll_gamepad)
+        elif self.backend.live:
             self.set_interval(1.0 / STICK_HZ, self.send_sticks)
 
     def on_unmount(self) -> None:
         """Let the backend release overrides and stop its thread."""
         self.backend.close()
+        if self.gamepad is not None:
+            self.gamepad.close()
 
     # --- display -------------------------------------------------------------------------
 
@@ -151,8 +162,22 @@ class TeleopApp(App[None]):
         self.query_one(HeightPlot).show(view)
         self.query_one(AccelPlot).show(view)
 
+    def poll_gamepad(self) -> None:
+        """Read the pad, send what it asks for, show it (UI thread, at the pad's poll rate)."""
+        assert self.gamepad is not None
+        for intent in self.gamepad.poll(self._clock(), self.backend.view()):
+            self.backend.send(intent)
+        self._show_pad()
+
+    def _show_pad(self) -> None:
+        pad = self.gamepad
+        if pad is not None and not self.frozen and self._showing("#pad"):
+            self.query_one(PadPanel).show(pad.name, pad.source.mapping.key, pad.status)
+
     def send_sticks(self) -> None:
         """Hand the current stick positions to the loop (it repeats them every 25 ms)."""
+        if self.gamepad is not None:
+            return  # two writers of sticks would fight; the pad has them
         now = self._clock()
         self.backend.send(
             intents.Sticks(

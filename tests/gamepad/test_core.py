@@ -131,7 +131,7 @@ def test_first_pad_needs_a_neutral_throttle_then_a_button() -> None:
     c = Clock(GamepadPilot(PadSettings(throttle="full")))
     out = c.step(pad(0.0), DISARMED)  # a spring-centred stick in full mode: 1500 us
     assert c.pilot.phase is PadPhase.WAITING and sticks(out).throttle_us == 1000
-    assert "throttle to minimum" in c.pilot.status.note
+    assert "throttle down" in c.pilot.status.note
     assert others(c.step(pad(0.0, 0, 0, 0, "arm"), DISARMED)) == []  # not neutral: nothing
     c.step(pad(-1.0), DISARMED)
     assert c.pilot.phase is PadPhase.WAITING
@@ -189,7 +189,7 @@ def test_replug_in_hold_needs_a_centred_throttle_and_a_button() -> None:
     out = c.step(pad(0.8, 0.9), PC_HOLD)  # back, throttle up and rolling: ignored
     assert c.pilot.phase is PadPhase.WAITING and sticks(out).roll == 0.0
     assert not [i for i in out if isinstance(i, intents.SetpointStep)]
-    assert "centre the throttle" in c.pilot.status.note
+    assert "throttle to centre" in c.pilot.status.note
     c.step(pad(0.8, 0.9, 0, 0, "hold"), PC_HOLD)
     assert c.pilot.phase is PadPhase.WAITING
     c.step(pad(0.0), PC_HOLD)
@@ -207,7 +207,7 @@ def test_replug_after_land_needs_the_throttle_at_minimum() -> None:
     assert c.pilot.status.note == "unplugged: LAND commanded"
     c.step(pad(0.1, 0, 0, 0, "a"), LANDING)
     c.step(pad(0.1, 0, 0, 0, "arm"), LANDING)
-    assert c.pilot.phase is PadPhase.WAITING and "throttle to minimum" in c.pilot.status.note
+    assert c.pilot.phase is PadPhase.WAITING and "throttle down" in c.pilot.status.note
     c.step(pad(-1.0), LANDING)
     c.step(pad(-1.0, 0, 0, 0, "arm"), LANDING)
     assert c.pilot.phase is PadPhase.ENGAGED and c.pilot.status.note == ""
