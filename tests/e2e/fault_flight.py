@@ -31,7 +31,7 @@ import numpy as np
 
 from sitl.fault_frames import Counters, Direction
 from sitl.fault_proxy import FaultProxy
-from tests.e2e.fault_watch import MavWatcher, OverrideTap, SimClockMap
+from tests.e2e.fault_watch import MavWatcher, SimClockMap, StationTap
 
 ROOT = Path(__file__).resolve().parents[2]
 REST_ALT_M = 0.06  # the station's floor reference: its altitude of a vehicle standing on the floor
@@ -100,6 +100,7 @@ class FlightResult:
     down: Counters
     wall_s: float
     overrides: list[tuple[float, int]]  # (sim t, throttle us) of every override that got through
+    sent: list[tuple[float, str, str, int]]  # (sim t, fate, kind, value) of the station's frames
 
     # ------------------------------------------------------------ derived numbers
     @property
@@ -243,6 +244,22 @@ class FlightResult:
         return (max(first), int(np.median(later)) if later else 0,
                 released[0] if released else None)
 
+    @property
+    def station_after_fault(self) -> dict[str, Any] | None:
+        """What the station sent from the fault on, in seconds after its start: its LAND
+        requests (SET_MODE 9, whatever became of them), when it released the overrides (throttle
+        0), and its last frame of any kind (then it was silent, or fly had ended)."""
+        if self.fault_start_s is None:
+            return None
+        t0 = self.fault_start_s
+        after = [(t - t0, kind, v) for t, _, kind, v in self.sent if t >= t0]
+        lands = [round(t, 2) for t, kind, v in after if kind == "set_mode" and v == MODE_LAND]
+        released = [t for t, kind, v in after if kind == "override" and v == 0]
+        return {"land_requests_s": lands,
+                "released_s": round(released[0], 2) if released else None,
+                "last_frame_s": round(after[-1][0], 2) if after else None,
+                "heartbeats": sum(kind == "heartbeat" for _, kind, _ in after)}
+
     def _score(self) -> str:
         s = self.summary or {}
         keys = ("status", "rms_error_m", "max_error_m", "error_source", "link_down_s")
@@ -269,7 +286,8 @@ class FlightResult:
                 f"{f(self.open_loop_s, ' s')}, drift {drift and tuple(round(d, 3) for d in drift)}"
                 f"; last throttle before the fault (us, hold median, ±5-95 %) "
                 f"{self.last_throttle_us}; station's throttle blind (max 0-0.5 s, median "
-                f"0.5-1.5 s, released after s) {self.gap_throttle_us}"
+                f"0.5-1.5 s, released after s) {self.gap_throttle_us}; station after the fault "
+                f"{self.station_after_fault}"
                 f"; hold dev in fault {f(self.hold_during_fault_m, ' m')}; params "
                 f"{self.params}; fly's own score {self._score()}; proxy up [{self.up.line()}] "
                 f"down [{self.down.line()}]; "
@@ -328,7 +346,7 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
         host, port = mocap_url.removeprefix("tcp:").rsplit(":", 1)
         watch_mocap = MavWatcher(socket.create_connection((host, int(port)), 5.0), udp=False)
         stack.callback(watch_mocap.close)
-        tap = OverrideTap()
+        tap = StationTap()
         if transport == "serial":
             proxy = FaultProxy(serial_port=sitl.endpoint(1, "serial"), seed=seed,
                                time_scale=speedup, tap=tap)
@@ -373,7 +391,8 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
             texts=[(clock(w), s) for w, s in watch_udp.texts],
             params=params, up=proxy.counters("up"), down=proxy.counters("down"),
             wall_s=time.monotonic() - wall0,
-            overrides=[(clock(w), thr) for w, thr in tap.throttle])
+            overrides=[(clock(w), thr) for w, thr in tap.throttle],
+            sent=[(clock(w), fate, kind, v) for w, fate, kind, v in tap.sent])
 
 
 def _disarmed_after(w: MavWatcher, wall: float) -> bool:

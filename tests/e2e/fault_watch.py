@@ -1,10 +1,9 @@
 """What the fault suite watches from outside the link it breaks: motion capture and a
-listen-only UDP endpoint of the SITL (`MavWatcher`), the overrides that reached the vehicle (a
-fault-proxy tap), and the map from wall-clock stamps to the SITL's simulated time."""
+listen-only UDP endpoint of the SITL (`MavWatcher`), what the station sent up and what became
+of it (a fault-proxy tap), and the map from wall-clock stamps to the SITL's simulated time."""
 
 from __future__ import annotations
 
-import contextlib
 import select
 import socket
 import threading
@@ -17,7 +16,6 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink
 from sitl.fault_frames import Direction
 
 OBSERVER_SYSID = 254  # not SYSID_MYGCS: its requests never count as the GCS being alive
-RC_OVERRIDE_ID = mavlink.MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE
 
 
 class MavWatcher:
@@ -85,19 +83,37 @@ class MavWatcher:
         self.sock.close()
 
 
-class OverrideTap:
-    """The proxy's tap: the throttle of every RC_CHANNELS_OVERRIDE that reached the vehicle."""
+class StationTap:
+    """The proxy's tap on the uplink: what the station sent and what became of it. Keeps every
+    override's throttle, every SET_MODE's mode and every station heartbeat, with its fate."""
 
     def __init__(self) -> None:
-        self.throttle: list[tuple[float, int]] = []  # (wall, chan3 us)
+        self.throttle: list[tuple[float, int]] = []  # (wall, chan3 us) of overrides that passed
+        self.sent: list[tuple[float, str, str, int]] = []  # (wall, fate, kind, value)
         self._mav = mavlink.MAVLink(None)
 
     def __call__(self, d: Direction, fate: str, frame: bytes, wall: float) -> None:
-        msg_id = frame[5] if frame[0] == 0xFE else frame[7] | frame[8] << 8 | frame[9] << 16
-        if d is not Direction.UP or fate != "passed" or msg_id != RC_OVERRIDE_ID:
+        if d is not Direction.UP:
             return
-        with contextlib.suppress(Exception):  # a frame it cannot decode is no override
-            self.throttle.append((wall, int(self._mav.decode(bytearray(frame)).chan3_raw)))
+        msg_id = frame[5] if frame[0] == 0xFE else frame[7] | frame[8] << 8 | frame[9] << 16
+        kind = KINDS.get(msg_id)
+        if kind is None:
+            self.sent.append((wall, fate, "other", msg_id))
+            return
+        try:
+            msg = self._mav.decode(bytearray(frame))
+        except Exception:  # a frame it cannot decode is no command
+            return
+        value = int(getattr(msg, FIELDS[kind]))
+        self.sent.append((wall, fate, kind, value))
+        if kind == "override" and fate == "passed":
+            self.throttle.append((wall, value))
+
+
+KINDS = {mavlink.MAVLINK_MSG_ID_RC_CHANNELS_OVERRIDE: "override",
+         mavlink.MAVLINK_MSG_ID_SET_MODE: "set_mode",
+         mavlink.MAVLINK_MSG_ID_HEARTBEAT: "heartbeat"}
+FIELDS = {"override": "chan3_raw", "set_mode": "custom_mode", "heartbeat": "type"}
 
 
 class SimClockMap:

@@ -10,8 +10,9 @@ What the station's policy promises: proof of life is any frame; a short gap hold
 command; a gap over ~1 s makes it request LAND for a few seconds, then stop heartbeats and
 overrides so the autopilot's own failsafe acts if the uplink is dead too; nothing resumes when
 the link returns. So for a lost link, one way or both: never above setpoint + 0.3 m, touchdown
-no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault, and `fly` exits 3
-with a reason line. With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m and exits 0.
+no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault, `fly` exits 3 with
+a reason line, and a station that cannot see the vehicle asks for LAND more than once (what it
+sent is read off the uplink by a tap in the proxy, whether the frames got through or not). With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m and exits 0.
 
 The matrix is flown once per session (a module fixture, only the selected cases), in real time
 three flights at a time, or QUADGCS_FAULT_SPEEDUP=K times faster (tests/e2e/fault_flight.py).
@@ -43,6 +44,7 @@ LOSSY_HOLD_M = 0.1
 # worse means the machine could not keep up with the run, and the fault tells nothing.
 PRE_FAULT_RMS_M = 0.05
 FLIGHT_FAILED_EXIT = 3
+MIN_LAND_REQUESTS = 2  # "requests LAND (SET_MODE, repeated) for a few seconds"
 
 
 @pytest.fixture(scope="module")
@@ -79,6 +81,14 @@ def _problems(r: FlightResult) -> list[str]:
                        f"{FLIGHT_FAILED_EXIT} and a reason line")
         if c.direction is not Direction.DOWN and r.land_mode_s is None and not r.failsafe_texts:
             out.append("the vehicle's own failsafe never acted (no LAND, no failsafe text)")
+        sent = r.station_after_fault or {}
+        lands = sent.get("land_requests_s", [])
+        if c.direction is not Direction.UP and len(lands) < MIN_LAND_REQUESTS:
+            # blind, the station cannot know whether one SET_MODE arrived: it must repeat it
+            out.append(f"the blind station asked for LAND {len(lands)} time(s) "
+                       f"(at {lands} s after the fault), not repeatedly; its last frame at "
+                       f"{sent.get('last_frame_s')} s, overrides released at "
+                       f"{sent.get('released_s')} s")
     else:
         dev = r.hold_during_fault_m
         if dev is None or not dev <= LOSSY_HOLD_M:
