@@ -12,7 +12,8 @@ overrides so the autopilot's own failsafe acts if the uplink is dead too; nothin
 the link returns. So for a lost link, one way or both: never above setpoint + 0.3 m, touchdown
 no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault, `fly` exits 3 with
 a reason line, and a station that cannot see the vehicle asks for LAND more than once (what it
-sent is read off the uplink by a tap in the proxy, whether the frames got through or not). With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m and exits 0.
+sent is read off the uplink by a tap in the proxy, whether the frames got through or not).
+With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m and exits 0.
 
 The matrix is flown once per session (a module fixture, only the selected cases), in real time
 three flights at a time, or QUADGCS_FAULT_SPEEDUP=K times faster (tests/e2e/fault_flight.py).
