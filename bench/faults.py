@@ -12,7 +12,9 @@ bit flips both ways for 60 s. `--serial` adds both-ways loss over the 115200-bau
 Columns: fault | profile | documented response | max height over setpoint | touchdown speed
 (vertical, just before contact) | time from the fault to disarm | fly's exit code; then the
 open-loop seconds (uplink dead, before the vehicle's own failsafe acts) and their drift, and
-the worst hold error during a lossy fault.
+the worst hold error during a lossy fault; what the station sent once blind (its LAND requests,
+when it released the overrides, its last frame; read off the uplink by a proxy tap) and the
+throttle the vehicle was left with.
 
 Prints numbers; asserts nothing.
 
@@ -64,6 +66,18 @@ def details(r: FlightResult) -> str:
         fs = ", ".join(s for _, s in r.failsafe_texts[:2]) or "LAND seen"
         parts.append(f"open loop {r.open_loop_s:.1f} s (drift {change:+.3f} m, widest "
                      f"{widest:.3f} m) until the vehicle's failsafe ({fs})")
+    sent = r.station_after_fault
+    if sent is not None and r.case.lands:
+        parts.append(f"station: LAND asked at {sent['land_requests_s']} s, overrides released "
+                     f"at {sent['released_s']} s, last frame at {sent['last_frame_s']} s")
+    gap = r.gap_throttle_us
+    if gap is not None:
+        parts.append(f"blind throttle: up to {gap[0]} us in the first 0.5 s, then {gap[1]} us "
+                     f"(hold median before {r.last_throttle_us[1] if r.last_throttle_us else '-'}"
+                     " us)")
+    elif r.open_loop_s is not None and r.last_throttle_us is not None:
+        last, mid, band = r.last_throttle_us
+        parts.append(f"left with {last} us (hold median {mid:.0f} ± {band:.0f} us)")
     if not r.case.lands and r.hold_during_fault_m is not None:
         parts.append(f"worst hold error in the fault {r.hold_during_fault_m * 100:.1f} cm; "
                      f"corrupted up/down {r.up.frames_corrupted}/{r.down.frames_corrupted}")
