@@ -14,6 +14,7 @@ import sys
 from collections.abc import Sequence
 
 from firmware_link.errors import LinkError
+from gcs.commands import _help
 from gcs.errors import QuadgcsError
 
 COMMAND_MODULES: tuple[str, ...] = (
@@ -34,7 +35,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="quadgcs",
         description="Ground-control station for small indoor quadrotors (MAVLink, ArduCopter).",
     )
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND",
+                                help="what to do (quadgcs COMMAND --help for its flags)")
     for name in COMMAND_MODULES:
         module_name = f"gcs.commands.{name}"
         try:
@@ -44,6 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
                 raise
             continue
         module.register(sub)
+    _help.apply(parser)
     return parser
 
 

@@ -91,12 +91,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--serial", action="store_true", help="also open a pseudo-terminal serial port (115200)"
     )
-    parser.add_argument("--vehicles", type=_vehicles, default=1, metavar="N")
-    parser.add_argument("--speedup", type=_positive, default=1.0, metavar="K")
+    parser.add_argument("--vehicles", type=_vehicles, default=1, metavar="N",
+                        help=f"how many vehicles, 1..{MAX_VEHICLES} (default 1)")
+    parser.add_argument("--speedup", type=_positive, default=1.0, metavar="K",
+                        help="run the simulation K times faster than real time (default 1)")
     parser.add_argument(
-        "--profile", choices=[p.value for p in Profile], default=Profile.APM25.value
+        "--profile", choices=[p.value for p in Profile], default=Profile.APM25.value,
+        help="firmware to behave as: apm25 = ArduCopter 3.2.1 (MAVLink 1), copter4 = "
+        "ArduCopter 4.x (MAVLink 2) (default apm25)",
     )
-    parser.add_argument("--seed", type=int, default=0, metavar="N")
+    parser.add_argument("--seed", type=int, default=0, metavar="N",
+                        help="seed of the sensor noise and biases (default 0)")
     parser.add_argument(
         "--signing-key", metavar="FILE", help="MAVLink 2 signing key (copter4 only)"
     )

@@ -22,7 +22,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "logs", help="inspect, export, recover and plot flight recordings (MCAP)"
     )
-    sub = parser.add_subparsers(dest="logs_command", metavar="ACTION")
+    sub = parser.add_subparsers(dest="logs_command", metavar="ACTION", help="what to do")
     parser.set_defaults(func=_missing_action(parser))
 
     info = sub.add_parser("info", help="duration, topics, counts, rates, gaps, link losses")

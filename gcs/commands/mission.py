@@ -22,7 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the `mission` subcommand (with `run`)."""
     p = sub.add_parser("mission", help="run a mission file (EPBHA, flocking, radiation)",
                        description=__doc__)
-    msub = p.add_subparsers(dest="mission_command", metavar="ACTION")
+    msub = p.add_subparsers(dest="mission_command", metavar="ACTION", help="what to do")
     r = msub.add_parser("run", help="fly a mission file", description=__doc__)
     r.add_argument("file", type=Path, help="mission TOML (see missions/)")
     r.add_argument("--connect", metavar="URL",

@@ -73,19 +73,21 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("params", help="show, get, set, save, load or diff vehicle parameters",
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_vehicle_flags(p, on_action=False)
-    actions = p.add_subparsers(dest="action", metavar="ACTION")
+    actions = p.add_subparsers(dest="action", metavar="ACTION", help="what to do")
     specs: tuple[tuple[str, str, Callable[[argparse.ArgumentParser], None]], ...] = (
         ("show", "list parameters (NAME VALUE, sorted)", lambda a: a.add_argument(
             "pattern", nargs="?", default="*", help="shell-style pattern, e.g. 'ATC_RAT_*'")),
-        ("get", "print one parameter", lambda a: a.add_argument("name")),
+        ("get", "print one parameter", lambda a: a.add_argument(
+            "name", help="parameter name, e.g. FS_GCS_ENABLE")),
         ("set", "set one parameter and confirm it", lambda a: (
-            a.add_argument("name"), a.add_argument("value"))),
+            a.add_argument("name", help="parameter name, e.g. FS_GCS_ENABLE"),
+            a.add_argument("value", help="new value (a number)"))),
         ("save", "write every parameter to a .parm file", lambda a: a.add_argument(
-            "file", type=Path)),
+            "file", type=Path, help=".parm file to write (NAME VALUE per line)")),
         ("load", "set the parameters of a .parm file", lambda a: a.add_argument(
-            "file", type=Path)),
+            "file", type=Path, help=".parm file to read (NAME VALUE per line)")),
         ("diff", "compare the vehicle with a .parm file", lambda a: a.add_argument(
-            "file", type=Path)),
+            "file", type=Path, help=".parm file to compare with")),
     )
     for name, helptext, add in specs:
         a = actions.add_parser(name, help=helptext)

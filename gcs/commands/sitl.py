@@ -22,6 +22,8 @@ FORWARDED: tuple[tuple[str, str], ...] = (
     ("seed", "--seed"),
     ("signing_key", "--signing-key"),
     ("mocap_port", "--mocap-port"),
+    ("copter4_version", "--copter4-version"),
+    ("truth_port", "--truth-port"),
 )
 
 
@@ -30,17 +32,37 @@ def register(subparsers: Any) -> None:
     p: argparse.ArgumentParser = subparsers.add_parser(
         "sitl", help="run the bundled simulated vehicle(s) behind MAVLink endpoints"
     )
-    p.add_argument("--world", metavar="FILE")
-    p.add_argument("--tcp", metavar="PORT")
-    p.add_argument("--udp", metavar="HOST:PORT")
-    p.add_argument("--serial", action="store_true")
-    p.add_argument("--vehicles", metavar="N")
-    p.add_argument("--speedup", metavar="K")
-    p.add_argument("--profile", choices=["apm25", "copter4"])
-    p.add_argument("--seed", metavar="N")
-    p.add_argument("--signing-key", metavar="FILE")
-    p.add_argument("--no-noise", action="store_true")
-    p.add_argument("--mocap-port", metavar="PORT")
+    # No defaults here: a flag not given is not passed on, and the SITL's own default holds
+    # (the help says which); the SITL checks the values and answers with its own message.
+    p.add_argument("--world", metavar="FILE", help="world TOML file (default: empty 6 m room)")
+    p.add_argument("--tcp", metavar="PORT",
+                   help="TCP port of vehicle 1; vehicle i gets PORT+10*(i-1); 0 = OS-chosen "
+                        "(default 5760)")
+    p.add_argument("--udp", metavar="HOST:PORT", help="also send MAVLink to HOST:PORT (UDP)")
+    p.add_argument("--serial", action="store_true",
+                   help="also open a pseudo-terminal serial port (115200 baud)")
+    p.add_argument("--vehicles", metavar="N", help="how many vehicles, 1..5 (default 1)")
+    p.add_argument("--speedup", metavar="K",
+                   help="run the simulation K times faster than real time (default 1)")
+    p.add_argument("--profile", choices=["apm25", "copter4"],
+                   help="firmware to behave as: apm25 = ArduCopter 3.2.1 (MAVLink 1), copter4 "
+                        "= ArduCopter 4.x (MAVLink 2) (default apm25)")
+    p.add_argument("--seed", metavar="N", help="seed of the sensor noise (default 0)")
+    p.add_argument("--signing-key", metavar="FILE",
+                   help="MAVLink 2 signing key file (copter4 only; default: no signing)")
+    p.add_argument("--no-noise", action="store_true",
+                   help="perfect sensors (tests of the physics only)")
+    p.add_argument("--realistic-boot", action="store_true",
+                   help="copter4: refuse to arm for the real ≈24 s after boot (default ≈3 s)")
+    p.add_argument("--copter4-version", choices=["4.6", "4.7"],
+                   help="copter4 parameter names: 4.7 (MAV_GCS_SYSID, MAVn_*) or 4.6 for any "
+                        "4.x before 4.7 (SYSID_MYGCS, SRn_*) (default 4.7)")
+    p.add_argument("--truth-port", metavar="PORT",
+                   help="open a ground-truth TCP endpoint for scoring (0 = OS-chosen; default: "
+                        "none)")
+    p.add_argument("--mocap-port", metavar="PORT",
+                   help="motion-capture TCP port when the world has it on (default 5750; "
+                        "OS-chosen with --tcp 0)")
     p.set_defaults(func=run)
 
 
@@ -55,6 +77,8 @@ def sitl_argv(args: argparse.Namespace) -> list[str]:
         argv.append("--serial")
     if args.no_noise:
         argv.append("--no-noise")
+    if getattr(args, "realistic_boot", False):
+        argv.append("--realistic-boot")
     return argv
 
 
