@@ -1,7 +1,9 @@
 """What Foxglove's 3D panel needs to show a flight move, derived from what the station records.
 
 `FoxgloveFeed` stands where the station expects its recorder: every `put` and `put_raw` goes on
-unchanged to the recorder and to the live view (either may be absent), and from the station's
+unchanged to the recorder and to the live view (either may be absent; with both, the live view
+takes the recorder's JSON from its writer thread instead of encoding it again), and from the
+station's
 own topics it derives, at most `rate_hz` times a second of station time (files stay small, and a
 25 ms loop pays for one small dict now and then, not per record):
 
@@ -103,6 +105,11 @@ class FoxgloveFeed:
         self.mocap_frame = f"vehicle{sysid}_mocap"
         # several vehicles share one live view: their station topics are told apart there
         self.live_prefix = live_prefix
+        # with a recording the live view is fed the recorder's own JSON (one encoding, one
+        # Python worker competing with the loop for the GIL); without one it encodes itself
+        self._live_direct = live if recorder is None else None
+        if recorder is not None and live is not None:
+            recorder.add_tap(self._tap)
         self._period_s = 1.0 / rate_hz
         self._world = foxglove_scene_from_boxes(boxes, entity_id="world") if boxes else None
         self._next_world_s = -math.inf
@@ -143,25 +150,33 @@ class FoxgloveFeed:
         """Forward one raw MAVLink frame."""
         if self.recorder is not None:
             self.recorder.put_raw(direction, t_s, data)
-        if self.live is not None:
-            self.live.put_raw(direction, t_s, data)
+        if self._live_direct is not None:
+            self._live_direct.put_raw(direction, t_s, data)
 
     def event(self, t_s: float, level: Any, text: str) -> None:
         """Forward a human-readable event ("/log")."""
         if self.recorder is not None:
             self.recorder.event(t_s, level, text)
-        if self.live is not None:
-            self.live.event(t_s, level, text)
+        if self._live_direct is not None:
+            self._live_direct.event(t_s, level, text)
 
     # Derived topics.
+
+    def _live_topic(self, topic: str) -> str:
+        # mission topics already name their vehicle (/v3/mission/pose)
+        if not self.live_prefix or topic.startswith(("/mission", "/v")):
+            return topic
+        return self.live_prefix + topic
+
+    def _tap(self, topic: str, schema_name: str, schema: Any, log_ns: int, data: bytes) -> None:
+        # the recorder's writer thread
+        self.live.publish(self._live_topic(topic), schema_name, schema, log_ns, data)
 
     def _out(self, topic: str, t_s: float, payload: Any) -> None:
         if self.recorder is not None:
             self.recorder.put(topic, t_s, payload)
-        if self.live is not None:
-            # mission topics already name their vehicle (/v3/mission/pose)
-            prefix = self.live_prefix if not topic.startswith(("/mission", "/v")) else ""
-            self.live.put(prefix + topic, t_s, payload)
+        if self._live_direct is not None:
+            self._live_direct.put(self._live_topic(topic), t_s, payload)
 
     def _on_intent(self, intent: Intent) -> None:
         if intent.kind is IntentKind.POSITION:

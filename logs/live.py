@@ -40,6 +40,7 @@ DEFAULT_HOST = "127.0.0.1"  # a flight is shown on this machine unless the pilot
 DEFAULT_PORT = 8765
 SUBPROTOCOL = "foxglove.sdk.v1"
 YIELD_AFTER_S = 0.0002  # worker time slice before it hands the GIL back to the loop
+WAKE_EVERY_S = 0.05
 DISPLAY_TF_EVERY_S = 1.0  # a client that joins late still gets the world → ned transform
 RAW_FRAME_SCHEMA_NAME = "quadgcs.MavlinkFrame"
 _RAW_SCHEMA: dict[str, Any] = {
@@ -108,6 +109,7 @@ class LiveView:
         self._dropped = 0
         self._rejected = 0
         self._last_tf_ns: int | None = None
+        self._create_lock = threading.Lock()
         self._thread = threading.Thread(target=self._run, name="foxglove-live", daemon=True)
         self._thread.start()
 
@@ -152,16 +154,26 @@ class LiveView:
 
     def publish(self, topic: str, schema_name: str, schema: Mapping[str, Any] | bytes,
                 log_ns: int, data: bytes) -> None:
-        """Queue an already-encoded JSON message with its schema (a replay's recorded bytes)."""
-        self._enqueue("bytes", topic, int(log_ns), (schema_name, schema, bytes(data)))
+        """Send an already-encoded JSON message with its schema now, on the caller's thread
+        (the recorder's writer, or a replay): no second Python thread wakes for it, and the
+        server's native code takes it from here. Dropped when nobody subscribed."""
+        if self._closed:
+            self._dropped += 1
+            return
+        try:
+            self._maybe_display_tf(log_ns)
+            channel = self._channel(topic, schema_name, schema)
+            if channel.has_sinks():
+                channel.log(data, log_time=int(log_ns))
+                self._published += 1
+        except Exception:  # an odd message is counted; the caller (the recorder) goes on
+            self._rejected += 1
 
     def _enqueue(self, kind: str, topic: str, log_ns: int, payload: Any) -> None:
         if self._closing or len(self._queue) >= self._max_queue:
             self._dropped += 1
             return
         self._queue.append((kind, topic, log_ns, payload))
-        if len(self._queue) == 1:
-            self._wake.set()
 
     def close(self) -> None:
         """Send what is queued, stop the worker and the server. Idempotent."""
@@ -196,29 +208,36 @@ class LiveView:
                     slice_end = time.perf_counter() + YIELD_AFTER_S
             if self._closing and not queue:
                 return
-            self._wake.wait(timeout=0.05)
+            # woken on a timer, not per message: one wake-up per batch keeps the GIL off the
+            # loop's thread except in a few short slices a second
+            self._wake.wait(timeout=WAKE_EVERY_S)
             self._wake.clear()
 
     def _channel(self, topic: str, schema_name: str, schema: Mapping[str, Any] | bytes) -> Any:
         channel = self._channels.get(topic)
         if channel is None:
-            fg = self._foxglove
-            data = schema if isinstance(schema, bytes) else json.dumps(schema).encode()
-            channel = fg.Channel(topic, schema=fg.Schema(name=schema_name, encoding="jsonschema",
-                                                         data=data),
-                                 message_encoding="json", context=self._context)
-            self._channels[topic] = channel
+            with self._create_lock:  # the worker and a publishing thread may both get here
+                channel = self._channels.get(topic)
+                if channel is None:
+                    fg = self._foxglove
+                    data = schema if isinstance(schema, bytes) else json.dumps(schema).encode()
+                    channel = fg.Channel(
+                        topic, schema=fg.Schema(name=schema_name, encoding="jsonschema",
+                                                data=data),
+                        message_encoding="json", context=self._context)
+                    self._channels[topic] = channel
         return channel
+
+    def _maybe_display_tf(self, log_ns: int) -> None:
+        last = self._last_tf_ns
+        if last is None or log_ns - last >= DISPLAY_TF_EVERY_S * 1e9:
+            self._last_tf_ns = log_ns
+            self._send_foxglove(TF_TOPIC, log_ns, ned_display_transform())
 
     def _publish_item(self, kind: str, topic: str, log_ns: int, payload: Any) -> None:
         try:
-            if self._last_tf_ns is None or log_ns - self._last_tf_ns >= DISPLAY_TF_EVERY_S * 1e9:
-                self._last_tf_ns = log_ns
-                self._send_foxglove(TF_TOPIC, log_ns, ned_display_transform())
-            if kind == "bytes":
-                schema_name, schema, data = payload
-                self._channel(topic, schema_name, schema).log(data, log_time=log_ns)
-            elif kind == "raw":
+            self._maybe_display_tf(log_ns)
+            if kind == "raw":
                 channel = self._channel(topic, RAW_FRAME_SCHEMA_NAME, _RAW_SCHEMA)
                 if channel.has_sinks():  # nobody subscribed: skip the base64 and JSON
                     msg = {"data": base64.b64encode(payload).decode("ascii"), "len": len(payload)}

@@ -21,15 +21,16 @@ import json
 import threading
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from logs.encoding import schema_for_payload, to_jsonable
+from logs.encoding import encode_json, schema_for_payload, to_jsonable
 from logs.errors import RecordingError
 from logs.foxglove import (
+    WELL_KNOWN_SCHEMAS,
     FoxgloveMessage,
     LogLevel,
     foxglove_log,
@@ -52,6 +53,10 @@ RAW_FRAME_SCHEMA: dict[str, Any] = {
         "len": {"type": "integer", "minimum": 0},
     },
 }
+
+
+Tap = Callable[[str, str, Mapping[str, Any], int, bytes], None]
+"""(topic, schema name, JSON Schema, log time ns, the message's JSON) of each message written."""
 
 
 class Direction(enum.Enum):
@@ -214,6 +219,9 @@ class Recorder:
         self._sink.write_metadata(METADATA_NAME, encode_metadata(header))
         self._sink.flush()
         self._display_tf_written = False
+        self._taps: list[Tap] = []
+        self._tap_errors = 0
+        self._topic_schemas: dict[str, tuple[str, Mapping[str, Any]]] = {}
         self._last_log_ns: int | None = None
         self._reported_drops = 0
         self._thread = threading.Thread(
@@ -372,9 +380,9 @@ class Recorder:
                 self._display_tf_written = True
             if kind is _Kind.RAW:
                 if not self._sink.has_topic(topic):
-                    self._sink.add_topic(topic, RAW_FRAME_SCHEMA_NAME, RAW_FRAME_SCHEMA)
+                    self._add_topic(topic, RAW_FRAME_SCHEMA_NAME, RAW_FRAME_SCHEMA)
                 message = {"data": base64.b64encode(payload).decode("ascii"), "len": len(payload)}
-                self._sink.write(topic, log_ns, message)
+                self._write(topic, log_ns, message)
             elif kind is _Kind.EVENT:
                 level, text = payload
                 self._write_foxglove(topic, log_ns, foxglove_log(level, text, self.vehicle))
@@ -393,10 +401,31 @@ class Recorder:
             return
         self._written[topic] = self._written.get(topic, 0) + 1
 
+    def add_tap(self, tap: Tap) -> None:
+        """Also hand every message, once written, to `tap(topic, schema name, schema, log time
+        ns, JSON bytes)` on the writer thread (the live view: it reuses the recording's JSON
+        instead of encoding every message a second time). Call before the first put."""
+        self._taps.append(tap)
+
+    def _add_topic(self, topic: str, schema_name: str, schema: Mapping[str, Any]) -> None:
+        self._sink.add_topic(topic, schema_name, schema)
+        self._topic_schemas[topic] = (schema_name, schema)
+
+    def _write(self, topic: str, log_ns: int, message: Mapping[str, Any]) -> None:
+        data = encode_json(message)
+        self._sink.write_bytes(topic, log_ns, data)
+        if self._taps:
+            name, schema = self._topic_schemas[topic]
+            for tap in self._taps:
+                try:
+                    tap(topic, name, schema, log_ns, data)
+                except Exception:  # a live view's trouble must never cost the recording
+                    self._tap_errors += 1
+
     def _write_foxglove(self, topic: str, log_ns: int, message: FoxgloveMessage) -> None:
         if not self._sink.has_topic(topic):
-            self._sink.add_well_known_topic(topic, message.schema_name)
-        self._sink.write(topic, log_ns, stamped(message, log_ns))
+            self._add_topic(topic, message.schema_name, WELL_KNOWN_SCHEMAS[message.schema_name])
+        self._write(topic, log_ns, stamped(message, log_ns))
 
     def _write_record(self, topic: str, log_ns: int, payload: Any) -> None:
         if not (isinstance(payload, Mapping) or dataclasses.is_dataclass(payload)):
@@ -404,5 +433,5 @@ class Recorder:
         message = to_jsonable(payload)
         if not self._sink.has_topic(topic):
             name, schema = schema_for_payload(payload, message)
-            self._sink.add_topic(topic, name or schema_name_for_topic(topic), schema)
-        self._sink.write(topic, log_ns, message)
+            self._add_topic(topic, name or schema_name_for_topic(topic), schema)
+        self._write(topic, log_ns, message)

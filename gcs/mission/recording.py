@@ -54,25 +54,6 @@ def xyz(p: Sequence[float]) -> dict[str, float]:
     return {"x": float(p[0]), "y": float(p[1]), "z": float(p[2])}
 
 
-class LiveTee:
-    """A recorder (or none) and a live view, written to together (a kinematic mission)."""
-
-    def __init__(self, recorder: Any | None, live: Any) -> None:
-        self.recorder = recorder
-        self.live = live
-
-    @property
-    def path(self) -> Any:
-        """The recording's file (None when only live)."""
-        return getattr(self.recorder, "path", None)
-
-    def put(self, topic: str, t_s: float, payload: Any) -> None:
-        """Queue one message on both."""
-        if self.recorder is not None:
-            self.recorder.put(topic, t_s, payload)
-        self.live.put(topic, t_s, payload)
-
-
 class MissionRecording:
     """Writes mission topics to a `logs.Recorder` (or nowhere when it is None)."""
 

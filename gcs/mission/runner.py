@@ -18,7 +18,7 @@ from gcs.mission.kinematic import (
     run_radiation_kinematic,
 )
 from gcs.mission.planner_params import planner_setup
-from gcs.mission.recording import SUMMARY, LiveTee, MissionRecording
+from gcs.mission.recording import SUMMARY, MissionRecording
 from gcs.mission.report import MissionReport
 from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.world import MissionWorld, load_world
@@ -70,17 +70,19 @@ def run_mission(spec: MissionSpec, options: RunOptions,
 
         return run_on_vehicles(spec, mw, setup, options, progress)
     with contextlib.ExitStack() as stack:
-        recorder = _open_recorder(spec, options, "kinematic") if options.record else None
-        if recorder is not None:
-            stack.callback(recorder.close)
         live = None
-        if options.foxglove is not None:
+        if options.foxglove is not None:  # opened first, closed last: it gets every message
             from gcs.foxglove_feed import open_live
 
             live = open_live(options.foxglove)
             stack.callback(live.close)
             print(f"foxglove: live view on {live.url}", file=sys.stderr, flush=True)
-        rec = MissionRecording(LiveTee(recorder, live) if live is not None else recorder)
+        recorder = _open_recorder(spec, options, "kinematic") if options.record else None
+        if recorder is not None:
+            stack.callback(recorder.close)
+            if live is not None:
+                recorder.add_tap(live.publish)  # the recording's JSON, not encoded twice
+        rec = MissionRecording(recorder if recorder is not None else live)
         products: Any = None
         if spec.planner is PlannerKind.EPBHA:
             report = run_epbha_kinematic(spec, mw, setup, rec, progress)
