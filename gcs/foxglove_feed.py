@@ -13,7 +13,8 @@ own topics it derives, at most `rate_hz` times a second of station time (files s
 - `/gcs/scene/setpoint`: `foxglove.SceneUpdate`, a sphere at the held set point (a short
   lifetime, so it disappears when the station stops holding);
 - `/gcs/scene/world`: `foxglove.SceneUpdate`, the world file's room and boxes, and `/tf`'s
-  world → ned again, every few seconds (a seek or a late client still finds them).
+  world → ned again, every few seconds (a seek or a late client still finds them);
+- `/log`: each station event (`/gcs/events`) again as a `foxglove.Log` line, for the Log panel.
 
 Everything is built on the loop's thread as plain dicts; JSON and disk happen in the recorder's
 and the live view's own threads.
@@ -32,7 +33,9 @@ from gcs.errors import RuntimeFault, UsageError
 from gcs.supervisor import Intent, IntentKind
 from logs.errors import RecordingError
 from logs.foxglove import (
+    LogLevel,
     SceneBox,
+    foxglove_log,
     foxglove_scene,
     foxglove_scene_from_boxes,
     foxglove_transform,
@@ -40,7 +43,7 @@ from logs.foxglove import (
     scene_entity,
     scene_sphere,
 )
-from logs.topics import TF_TOPIC
+from logs.topics import LOG_TOPIC, TF_TOPIC
 
 POSE_ESTIMATE = "/gcs/pose/estimate"
 POSE_MOCAP = "/gcs/pose/mocap"
@@ -54,6 +57,13 @@ SETPOINT_DIAMETER_M = 0.12
 ROOM_COLOR = (0.8, 0.8, 0.9, 0.08)  # the room as a faint shell, as missions draw it
 # the bundled SITL's world when it is given none (sitl.world.default_world, as a file)
 DEFAULT_WORLD = Path(__file__).resolve().parents[1] / "worlds" / "empty_room.toml"
+
+
+def _log_level(level: Any) -> LogLevel:
+    try:
+        return LogLevel(int(level))
+    except (TypeError, ValueError):
+        return LogLevel.UNKNOWN
 
 
 def open_live(address: str) -> Any:
@@ -140,6 +150,9 @@ class FoxgloveFeed:
             self._alt_setpoint_m = float(payload.setpoint_m)
         elif topic == topics.INTENT and isinstance(payload, Intent):
             self._on_intent(payload)
+        elif topic == topics.EVENTS and hasattr(payload, "text"):
+            self._out(LOG_TOPIC, t_s, foxglove_log(_log_level(payload.level), payload.text,
+                                                    f"vehicle{self.sysid}"))
 
     @property
     def path(self) -> Path | None:

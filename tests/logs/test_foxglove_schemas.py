@@ -153,3 +153,48 @@ def test_the_official_schemas_refuse_the_old_scene() -> None:
     assert problems("foxglove.SceneUpdate", old)  # no entity timestamps
     assert problems("foxglove.SceneUpdate", stamped(foxglove_scene_from_boxes(
         [((0, 0, -1), (1, 1, 0))]), 10**18)) == []
+
+
+LAYOUT = ROOT / "docs" / "foxglove-layout.json"
+
+
+def _layout_paths(layout: dict) -> tuple[list[str], list[str]]:
+    """(every plotted message path, every topic a panel names) of a Foxglove layout."""
+    plots: list[str] = []
+    topics: list[str] = []
+    for panel_id, config in layout["configById"].items():
+        if panel_id.startswith("Plot!"):
+            plots += [p["value"] for p in config["paths"]]
+        elif panel_id.startswith("RosOut!"):
+            topics.append(config["topicToRender"])
+    return plots, topics
+
+
+def _field(message: Any, path: str) -> Any:
+    for part in path.replace("[", ".[").split("."):
+        message = message[int(part[1:-1])] if part.startswith("[") else message[part]
+    return message
+
+
+@pytest.mark.e2e
+def test_the_layout_opens_a_fly_recording_usefully(fly_recording: Path) -> None:
+    layout = json.loads(LAYOUT.read_text(encoding="utf-8"))
+    panels = {panel_id.split("!")[0] for panel_id in layout["configById"]}
+    assert {"3D", "Plot", "RosOut"} <= panels
+    assert (ROOT / "README.md").read_text(encoding="utf-8").count("docs/foxglove-layout.json")
+    plots, topics = _layout_paths(layout)
+    with open(fly_recording, "rb") as f:
+        summary = make_reader(f).get_summary()
+    recorded = {c.topic for c in summary.channels.values()}
+    for path in plots:
+        topic = max((t for t in recorded if path.startswith(t + ".")), key=len, default=None)
+        assert topic is not None, f"layout plots {path}: no such topic in a fly recording"
+        (_, first), *_ = _messages(fly_recording, topic)
+        value = _field(first, path[len(topic) + 1:])
+        assert isinstance(value, int | float) and not isinstance(value, bool), path
+    for topic in topics:
+        assert topic in recorded, topic
+    three_d = next(c for k, c in layout["configById"].items() if k.startswith("3D!"))
+    assert three_d["followTf"] == "world"
+    for topic in (SCENE_WORLD, SCENE_SETPOINT):
+        assert three_d["topics"][topic]["visible"], topic
