@@ -187,3 +187,26 @@ async def test_pad_unplugged_under_manual_throttle_lands_after_the_timeout(
         await press(pilot, app, vpad, "x", backend, lambda v: True, 1.0)
         assert app.gamepad.status.phase is PadPhase.ENGAGED
     assert backend.error is None
+
+
+async def test_pad_climbs_by_throttle_in_stabilize_and_kills(
+        tmp_path: Path, vpad: VirtualPad) -> None:
+    backend, app = start(tmp_path)
+    async with app.run_test(size=(80, 26)) as pilot:
+        await wait_pad(pilot, app, lambda g: g.status.phase is PadPhase.ENGAGED, 5.0)
+        await press(pilot, app, vpad, "start", backend, lambda v: v.vehicle.armed, 20.0)
+        # the accumulating throttle: stick up raises it, centred it stays where it was put
+        vpad.axis("lefty", -1.0)
+        await wait_until(pilot, backend, lambda v: truth_alt(v) > 0.2, 20.0)
+        vpad.axis("lefty", 0.0)
+        await wait_pad(pilot, app, lambda g: g.status.throttle_axis == 0.0, 5.0)
+        assert app.gamepad is not None
+        put = app.gamepad.status.throttle_us
+        view = await wait_until(pilot, backend, lambda v: truth_alt(v) > 0.35, 10.0)
+        assert view.vehicle.mode == "STABILIZE" and not view.altitude.hold_on
+        assert app.gamepad.status.throttle_us == put  # stayed where it was put
+        assert view.altitude.throttle_us == put  # and the supervisor let it through
+        await press(pilot, app, vpad, "b", backend, lambda v: not v.vehicle.armed, 10.0)
+        assert app.gamepad.status.throttle_us == 1000
+        await wait_until(pilot, backend, lambda v: truth_alt(v) < 0.15, 10.0)
+    assert backend.error is None
