@@ -60,7 +60,7 @@ def row(r: FlightResult) -> str:
 
 def details(r: FlightResult) -> str:
     """The second line: open-loop drift, the lossy hold, the stderr reason."""
-    parts = []
+    parts = [f"highest {_num(r.max_over_at_s, '+.1f')} s after the fault"]
     if r.open_loop_s is not None and r.open_loop_drift_m is not None:
         change, widest = r.open_loop_drift_m
         fs = ", ".join(s for _, s in r.failsafe_texts[:2]) or "LAND seen"
@@ -72,7 +72,7 @@ def details(r: FlightResult) -> str:
                      f"at {sent['released_s']} s, last frame at {sent['last_frame_s']} s")
     gap = r.gap_throttle_us
     if gap is not None:
-        parts.append(f"blind throttle: up to {gap[0]} us in the first 0.5 s, then {gap[1]} us "
+        parts.append(f"blind throttle: {gap[0]}..{gap[1]} us in the first 0.5 s, then {gap[2]} us "
                      f"(hold median before {r.last_throttle_us[1] if r.last_throttle_us else '-'}"
                      " us)")
     elif r.open_loop_s is not None and r.last_throttle_us is not None:
