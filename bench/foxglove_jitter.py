@@ -2,12 +2,14 @@
 
 Flies the bundled SITL in PC altitude hold at 1 m, recording as `quadgcs fly` does and serving
 the flight live (`--foxglove`), in alternating blocks of `--block-s` seconds: no client, then a
-real Foxglove WebSocket client (a separate process, as the Foxglove app is) subscribed to every
-topic. Alternating blocks see the same drift of machine load. Prints the loop's jitter (|tick
-period − 25 ms|) p50/p99 without and with the client, what the client received, and the p99
-difference against the goal (the Foxglove issue: ≤ +0.2 ms).
+real Foxglove WebSocket client (a separate process, as the Foxglove app is) subscribed to what
+Foxglove subscribes to with `docs/foxglove-layout.json` open (`--subscribe layout`: the plotted
+topics, the log, the 3D panel's scenes and every transform) or to every topic (`--subscribe all`,
+raw MAVLink included). Alternating blocks see the same drift of machine load. Prints the loop's
+jitter (|tick period − 25 ms|) p50/p99 without and with the client, what the client received,
+and the p99 difference against the goal (the Foxglove issue: ≤ +0.2 ms).
 
-    .venv/bin/python bench/foxglove_jitter.py [--blocks 6] [--block-s 10] [--seed 3]
+    .venv/bin/python bench/foxglove_jitter.py [--blocks 12] [--block-s 5] [--subscribe all]
 """
 
 from __future__ import annotations
@@ -23,10 +25,26 @@ from pathlib import Path
 import numpy as np
 
 GOAL_ADDED_P99_MS = 0.2
+LAYOUT = Path(__file__).resolve().parents[1] / "docs" / "foxglove-layout.json"
 
 
-def client_main(url: str) -> int:
-    """The client process: subscribe to everything advertised; on stdin's end, print counts."""
+def layout_wants(topic: str, schema_name: str) -> bool:
+    """Whether Foxglove with the project's layout open subscribes to this channel."""
+    layout = json.loads(LAYOUT.read_text(encoding="utf-8"))
+    wanted: set[str] = set()
+    for panel_id, config in layout["configById"].items():
+        if panel_id.startswith("Plot!"):
+            wanted |= {p["value"] for p in config["paths"]}
+        elif panel_id.startswith("RosOut!"):
+            wanted.add(config["topicToRender"] + ".")
+        elif panel_id.startswith("3D!"):
+            wanted |= {t + "." for t in config["topics"]}
+    return schema_name == "foxglove.FrameTransform" or any(
+        w.startswith(topic + ".") for w in wanted)
+
+
+def client_main(url: str, subscribe: str) -> int:
+    """The client process: subscribe to what `subscribe` says; on stdin's end, print counts."""
     import struct
 
     import websockets
@@ -47,11 +65,14 @@ def client_main(url: str) -> int:
                 if isinstance(frame, str):
                     msg = json.loads(frame)
                     if msg.get("op") == "advertise":
+                        chans = [ch for ch in msg["channels"] if subscribe == "all"
+                                 or layout_wants(ch["topic"], ch["schemaName"])]
                         new = [{"id": len(subs) + i + 1, "channelId": ch["id"]}
-                               for i, ch in enumerate(msg["channels"])]
-                        for s, ch in zip(new, msg["channels"], strict=True):
+                               for i, ch in enumerate(chans)]
+                        for s, ch in zip(new, chans, strict=True):
                             subs[s["id"]] = ch["topic"]
-                        await ws.send(json.dumps({"op": "subscribe", "subscriptions": new}))
+                        if new:
+                            await ws.send(json.dumps({"op": "subscribe", "subscriptions": new}))
                 elif frame[0] == 1:
                     struct.unpack_from("<IQ", frame, 1)
                     # counted, not decoded: it stands in for the Foxglove app's socket, and
@@ -65,7 +86,8 @@ def client_main(url: str) -> int:
     return 0
 
 
-def hover_blocks(blocks: int, block_s: float, seed: int) -> list[tuple[bool, np.ndarray, dict]]:
+def hover_blocks(blocks: int, block_s: float, seed: int,
+                 subscribe: str = "layout") -> list[tuple[bool, np.ndarray, dict]]:
     """Fly, then per block: (client connected?, the block's tick jitters in ms, client counts)."""
     from gcs.flight import FlightPlan, FlightRunner, Phase
     from gcs.session import SessionOptions, StationSession
@@ -98,7 +120,8 @@ def hover_blocks(blocks: int, block_s: float, seed: int) -> list[tuple[bool, np.
                 counts: dict = {}
                 if with_client:
                     client = subprocess.Popen(
-                        [sys.executable, "-P", __file__, "--client", session.live.url],
+                        [sys.executable, "-P", __file__, "--client", session.live.url,
+                         "--subscribe", subscribe],
                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
                     assert client.stdout is not None and client.stdin is not None
                     if client.stdout.readline().strip() != "connected":
@@ -120,14 +143,16 @@ def hover_blocks(blocks: int, block_s: float, seed: int) -> list[tuple[bool, np.
 def main() -> int:
     """Print the table and the verdict."""
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--blocks", type=int, default=6, help="alternating blocks (default 6)")
-    ap.add_argument("--block-s", type=float, default=10.0, help="seconds per block (default 10)")
+    ap.add_argument("--blocks", type=int, default=12, help="alternating blocks (default 12)")
+    ap.add_argument("--block-s", type=float, default=5.0, help="seconds per block (default 5)")
+    ap.add_argument("--subscribe", choices=("layout", "all"), default="layout",
+                    help="what the client subscribes to (default: the layout's topics)")
     ap.add_argument("--seed", type=int, default=3, help="SITL noise seed (default 3)")
     ap.add_argument("--client", metavar="URL", help=argparse.SUPPRESS)  # the client process
     args = ap.parse_args()
     if args.client:
-        return client_main(args.client)
-    blocks = hover_blocks(max(2, args.blocks), args.block_s, args.seed)
+        return client_main(args.client, args.subscribe)
+    blocks = hover_blocks(max(2, args.blocks), args.block_s, args.seed, args.subscribe)
     off = np.concatenate([j for c, j, _ in blocks if not c])
     on = np.concatenate([j for c, j, _ in blocks if c])
     got = [n for c, _, n in blocks if c]

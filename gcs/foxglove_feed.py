@@ -141,7 +141,7 @@ class FoxgloveFeed:
         elif topic == topics.MOCAP_POSE and isinstance(payload, MocapPose):
             self._mocap = payload
             if t_s >= self._next_mocap_s:
-                self._next_mocap_s = t_s + self._period_s
+                self._next_mocap_s = self._next(self._next_mocap_s, t_s)
                 self._out(POSE_MOCAP, t_s, foxglove_transform(
                     "ned", self.mocap_frame, payload.pos_n, payload.q_nb))
         elif topic == topics.ATTITUDE and isinstance(payload, Attitude):
@@ -200,6 +200,12 @@ class FoxgloveFeed:
         if intent.kind in (IntentKind.ALT_HOLD_OFF, IntentKind.KILL, IntentKind.QUIT):
             self._alt_setpoint_m = None
 
+    def _next(self, due_s: float, t_s: float) -> float:
+        # on a grid of the period, so a 40 Hz source gives 15 Hz on average, not 40/3; after a
+        # gap (or at the start) the grid restarts at the message
+        nxt = due_s + self._period_s
+        return nxt if nxt > t_s else t_s + self._period_s
+
     def _xy(self) -> tuple[float, float]:
         m = self._mocap
         return (m.pos_n[0], m.pos_n[1]) if m is not None else (0.0, 0.0)
@@ -211,7 +217,7 @@ class FoxgloveFeed:
             if self._world is not None:
                 self._out(SCENE_WORLD, t_s, self._world)
         if t_s >= self._next_estimate_s:
-            self._next_estimate_s = t_s + self._period_s
+            self._next_estimate_s = self._next(self._next_estimate_s, t_s)
             alt_m = float(getattr(est, "alt_m", math.nan))
             if math.isfinite(alt_m):
                 att = self._attitude
@@ -222,7 +228,7 @@ class FoxgloveFeed:
                           foxglove_transform("ned", self.estimate_frame, (x, y, -alt_m), q))
         sp = self._alt_setpoint_m
         if sp is not None and math.isfinite(sp) and t_s >= self._next_setpoint_s:
-            self._next_setpoint_s = t_s + self._period_s
+            self._next_setpoint_s = self._next(self._next_setpoint_s, t_s)
             x, y = self._position_sp if self._position_sp is not None else self._xy()
             sphere = scene_sphere((x, y, -sp), SETPOINT_DIAMETER_M, SETPOINT_COLOR)
             entity = scene_entity(f"vehicle{self.sysid}_setpoint", spheres=[sphere],
