@@ -64,6 +64,7 @@ class VehicleState:
     armed: bool = False
     hold_on: bool = False  # PC altitude hold, take-off included
     mode: str = ""
+    throttle_us: int | None = None  # the throttle the station sent last
 
 
 @dataclass(frozen=True, slots=True)
@@ -103,6 +104,7 @@ class GamepadPilot:
     _accum_us: float = THROTTLE_MIN_US  # the accumulate mode's throttle
     _sent_us: int = THROTTLE_MIN_US  # the throttle last sent (what the station now holds)
     _started: bool = False
+    _hold_was_on: bool = False
     _unmanned_since_s: float | None = None  # pad not in control under a manual throttle
     _land_sent_s: float | None = None
 
@@ -127,6 +129,13 @@ class GamepadPilot:
             self.phase = PadPhase.WAITING
             self._accum_us = self._sent_us  # pick up from the throttle the station holds
         held_altitude = vehicle.hold_on or vehicle.mode == "ALT_HOLD"
+        if (self._hold_was_on and not vehicle.hold_on and vehicle.armed
+                and vehicle.mode == "STABILIZE" and vehicle.throttle_us is not None):
+            # PC hold let go in STABILIZE: the supervisor holds the hold's last throttle until
+            # the pilot's meets it; an accumulated throttle starts there, so the pad has the
+            # vehicle at once instead of after a second of pushing up to it
+            self._accum_us = vehicle.throttle_us
+        self._hold_was_on = vehicle.hold_on
         if not vehicle.hold_on and vehicle.mode != "ALT_HOLD" and s.throttle == "accumulate":
             self._accum_us = max(THROTTLE_MIN_US, min(THROTTLE_MAX_US, self._accum_us
                                  + thr_axis * s.throttle_rate_us_per_s * dt))

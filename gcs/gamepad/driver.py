@@ -33,7 +33,7 @@ class PadSource(Protocol):
 def vehicle_state(view: TeleopView) -> VehicleState:
     """What the core needs to know of the vehicle, from the latest view."""
     return VehicleState(armed=view.vehicle.armed, hold_on=view.altitude.hold_on,
-                        mode=view.vehicle.mode)
+                        mode=view.vehicle.mode, throttle_us=view.altitude.throttle_us)
 
 
 class Gamepad:

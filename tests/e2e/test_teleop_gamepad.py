@@ -159,9 +159,14 @@ async def test_pad_unplugged_under_manual_throttle_lands_after_the_timeout(
     backend, app = start(tmp_path)
     async with app.run_test(size=(80, 26)) as pilot:
         await take_off_in_pc_hold(pilot, app, vpad, backend)
-        # PC hold off by button: the throttle is the pilot's now (held where the hold left it
-        # until the pad's stick comes to it)
+        # PC hold off by button: the pad's throttle starts where the hold left it, so the
+        # supervisor hands it the vehicle at once — a manual throttle
+        def pickups(v: TeleopView) -> int:
+            return sum("the pilot's throttle has the vehicle" in text for _, text in v.messages)
+
+        before = pickups(backend.view())  # one already: at arming, at minimum
         await press(pilot, app, vpad, "a", backend, lambda v: not v.altitude.hold_on, 5.0)
+        await wait_until(pilot, backend, lambda v: pickups(v) > before, 5.0)
         assert backend.view().vehicle.mode == "STABILIZE" and backend.view().vehicle.armed
         vpad.unplug()
         unplugged_at = time.monotonic()

@@ -244,3 +244,19 @@ def test_kill_works_while_waiting() -> None:
     out = c.step(pad(0.5, 0, 0, 0, "kill"), MANUAL)
     assert others(out) == [intents.Kill()] and sticks(out).throttle_us == 1000
     assert c.pilot.phase is PadPhase.WAITING
+
+
+def test_pc_hold_let_go_hands_over_the_holds_throttle() -> None:
+    c = Clock(GamepadPilot(PadSettings(expo=0.0, deadzone=0.0)))
+    c.step(pad(), PC_HOLD)
+    c.run(1.0, pad(0.5), PC_HOLD)  # moves the set point, not the throttle
+    let_go = VehicleState(armed=True, mode="STABILIZE", throttle_us=1483)
+    assert sticks(c.step(pad(), let_go)).throttle_us == 1483
+    assert sticks(c.run(0.5, pad(), let_go)[-1:]).throttle_us == 1483
+    # a hold that ends in LAND (the vehicle's own throttle) hands nothing over
+    c = Clock(GamepadPilot())
+    c.step(pad(), PC_HOLD)
+    assert sticks(c.step(pad(), VehicleState(armed=True, mode="LAND", throttle_us=1000))
+                  ).throttle_us == 1000
+    assert sticks(c.step(pad(), VehicleState(armed=True, mode="STABILIZE",
+                                             throttle_us=1450))).throttle_us == 1000
