@@ -2,8 +2,10 @@
 the same SDL joystick API as a real pad, and Textual's Pilot for the screen.
 
 The station runs in its own process, as `quadgcs teleop --gamepad` runs it; the pad is read on
-the app's side. The test moves sticks and presses buttons on the virtual pad, pulls it out
-mid-flight and plugs it back, and watches only what the pilot sees: the views.
+the app's side. The tests move sticks and press buttons on the virtual pad, pull it out
+mid-flight and plug it back, and watch only what the pilot sees: the views. Three flights: PC
+hold by button and a climb by stick, unplugged mid-hold (the hold goes on) and plugged back;
+a manual throttle unplugged (LAND after 2 s); a climb by throttle in STABILIZE and a kill.
 """
 
 from __future__ import annotations

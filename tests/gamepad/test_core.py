@@ -260,3 +260,12 @@ def test_pc_hold_let_go_hands_over_the_holds_throttle() -> None:
                   ).throttle_us == 1000
     assert sticks(c.step(pad(), VehicleState(armed=True, mode="STABILIZE",
                                              throttle_us=1450))).throttle_us == 1000
+
+
+def test_unplugged_in_the_vehicles_alt_hold_centres_the_throttle_too() -> None:
+    c = Clock(GamepadPilot(PadSettings(lost_land_s=2.0, expo=0.0, deadzone=0.0)))
+    c.step(pad(), DISARMED)
+    c.step(pad(0.4), ONBOARD_HOLD)  # climbing in the vehicle's ALT_HOLD
+    out = c.run(5.0, None, ONBOARD_HOLD)
+    assert not others(out)  # the vehicle holds its own altitude: no LAND
+    assert {s.throttle_us for s in out if isinstance(s, intents.Sticks)} == {1500}
