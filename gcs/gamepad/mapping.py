@@ -282,15 +282,12 @@ def load_mappings(user_file: Path | None = None) -> MappingSet:
     """The user's entries (if any) ahead of the bundled ones. A user's `[defaults]` apply to
     every entry, bundled ones included."""
     bundled = tomllib.loads(bundled_text())
-    user: dict[str, Any] = _read(user_file) if user_file is not None else {}
-    user_defaults = user.get("defaults", {}) if isinstance(user.get("defaults", {}), dict) else {}
-    # the bundled entries are built on the user's defaults so that one [defaults] table in the
-    # user's file (say, a smaller deadzone) reaches the pads it does not list
-    base, _ = parse_mapping({"defaults": bundled.get("defaults", {})}, "bundled pads.toml")
-    if user_defaults:
-        base = _settings(user_defaults, base, f"{user_file}: [defaults]")
+    source = "bundled pads.toml"
+    defaults, _ = parse_mapping({"defaults": bundled.get("defaults", {})}, source)
     entries: list[PadMapping] = []
     if user_file is not None:
-        _, entries = parse_mapping({**user, "defaults": {}}, str(user_file), base)
-    _, shipped = parse_mapping({**bundled, "defaults": {}}, "bundled pads.toml", base)
+        defaults, entries = parse_mapping(_read(user_file), str(user_file), defaults)
+    # the bundled entries are built on the user's defaults, so that one [defaults] table in the
+    # user's file (say, a smaller deadzone) reaches the pads it does not list
+    _, shipped = parse_mapping({**bundled, "defaults": {}}, source, defaults)
     return MappingSet(tuple(entries + shipped))

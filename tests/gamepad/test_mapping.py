@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -121,3 +122,15 @@ def test_controller_names_need_a_pad_in_sdls_database() -> None:
     xbox = load_mappings().entries[0]
     with pytest.raises(UsageError, match="is not in SDL's controller database"):
         xbox.check_against("Odd Stick", False, n_axes=6, n_buttons=15)
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("defaults = 3\n", "[defaults] must be a table"),
+    ("[defaults]\ndeadzone = 1.0\n", "deadzone = 1.0 is out of range"),
+    ("[colours]\n", "unknown table 'colours'"),
+    ("pads = 1\n", "[pads] must hold tables"),
+])
+def test_a_bad_defaults_or_top_level_table_is_one_line(tmp_path: Path, text: str,
+                                                       message: str) -> None:
+    with pytest.raises(UsageError, match=re.escape(message)):
+        load_mappings(write(tmp_path, text))
