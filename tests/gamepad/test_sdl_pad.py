@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from gcs.cli import main
+from gcs.cli import build_parser, main
+from gcs.commands.teleop import open_gamepad
 from gcs.errors import RuntimeFault, UsageError
 from gcs.gamepad.mapping import load_mappings
 from gcs.gamepad.sdl_pad import SdlPad, init_sdl, list_pads, quit_sdl
@@ -145,3 +146,15 @@ def test_cli_gamepad_flags_need_gamepad(capsys: pytest.CaptureFixture[str]) -> N
     assert "--gamepad-map and --gamepad-rate need --gamepad" in capsys.readouterr().err
     assert main(["teleop", "--gamepad", "--gamepad-rate", "0"]) == 2
     assert "--gamepad-rate 0: expected 0 < HZ <= 250" in capsys.readouterr().err
+
+
+def test_teleop_opens_the_pad_the_flags_name(xbox: VirtualPad) -> None:
+    args = build_parser().parse_args(["teleop", "--gamepad", "xbox", "--gamepad-rate", "25"])
+    gamepad = open_gamepad(args)
+    assert gamepad is not None
+    try:
+        assert gamepad.name == "Xbox 360 Controller" and gamepad.poll_hz == 25.0
+        assert gamepad.source.mapping.key == "xbox"
+    finally:
+        gamepad.close()
+    assert open_gamepad(build_parser().parse_args(["teleop"])) is None
