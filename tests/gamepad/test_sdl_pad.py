@@ -158,3 +158,14 @@ def test_teleop_opens_the_pad_the_flags_name(xbox: VirtualPad) -> None:
     finally:
         gamepad.close()
     assert open_gamepad(build_parser().parse_args(["teleop"])) is None
+
+
+def test_a_pad_is_found_by_sdls_controller_type() -> None:
+    # a name no entry matches, but Sony's DualShock 4 ids: SDL's database says ps4
+    ds4 = VirtualPad("Gamepad 7", vendor_id=0x054C, product_id=0x09CC)
+    try:
+        pad = SdlPad(None, load_mappings())
+        assert pad.mapping.key == "dualshock"
+        pad.close()
+    finally:
+        ds4.close()
