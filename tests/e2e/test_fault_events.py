@@ -32,8 +32,9 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 from sitl.fault_frames import Direction
 from sitl.fault_proxy import FaultProxy
-from tests.e2e.fault_flight import FLOOR_BAND_M, REST_ALT_M, ROOT, SETPOINT_M, _sitl
-from tests.e2e.fault_watch import MavWatcher, OverrideTap, SimClockMap
+from tests.e2e.fault_flight import ROOT, _sitl
+from tests.e2e.fault_result import FLOOR_BAND_M, REST_ALT_M, SETPOINT_M
+from tests.e2e.fault_watch import MavWatcher, SimClockMap, StationTap
 
 pytestmark = [pytest.mark.e2e, pytest.mark.timeout(300)]
 
@@ -82,7 +83,7 @@ Trigger = Callable[[subprocess.Popen[str], FaultProxy, MavWatcher], None]
 
 
 @contextlib.contextmanager
-def _rig(profile: str) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy, OverrideTap]]:
+def _rig(profile: str) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy, StationTap]]:
     udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     udp.bind(("127.0.0.1", 0))
     args = ["--tcp", "0", "--profile", profile, "--speedup", f"{SPEEDUP:g}", "--seed", "4",
@@ -95,7 +96,7 @@ def _rig(profile: str) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy
         host, port = mocap_url.removeprefix("tcp:").rsplit(":", 1)
         watch_mocap = MavWatcher(socket.create_connection((host, int(port)), 5.0), udp=False)
         stack.callback(watch_mocap.close)
-        tap = OverrideTap()
+        tap = StationTap()
         h, p = sitl.endpoint(1, "tcp").rsplit(":", 1)
         proxy = FaultProxy(target=(h, int(p)), seed=4, time_scale=SPEEDUP, tap=tap).start()
         stack.callback(proxy.stop)
