@@ -180,8 +180,8 @@ class StationSession:
         if o.foxglove is not None:
             self.live = open_live(o.foxglove)
             self._stack.callback(self.live.close)
-            if o.command != "teleop":  # teleop's screen owns the terminal
-                print(f"foxglove: live view on {self.live.url}", file=sys.stderr, flush=True)
+            # before any screen is up (teleop's starts once the session is ready)
+            print(f"foxglove: live view on {self.live.url}", file=sys.stderr, flush=True)
         for sysid, url in urls.items():
             self.vehicles[sysid] = self._open_vehicle(sysid, url, mocap_url, key, config)
         truth_url = getattr(self.sitl_endpoints, "truth", None)

@@ -33,12 +33,12 @@ def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
     add_foxglove_argument(p)
 
 
-def add_foxglove_argument(p: argparse.ArgumentParser) -> None:
+def add_foxglove_argument(p: argparse.ArgumentParser, note: str = "") -> None:
     """--foxglove [HOST:]PORT: the live view (fly, teleop, mission run, replay)."""
     p.add_argument("--foxglove", metavar="[HOST:]PORT",
                    help="serve the flight live to Foxglove over its WebSocket protocol "
                         "(ws://HOST:PORT, the recording's topics); HOST defaults to 127.0.0.1, "
-                        "use 0.0.0.0 to serve other machines; port 0 picks a free one")
+                        "use 0.0.0.0 to serve other machines; port 0 picks a free one" + note)
 
 
 def session_options(args: argparse.Namespace, command: str) -> SessionOptions:

@@ -37,7 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              "station-config keys; alt. = altitude.gains., est. = estimator., "
                              "pos. = position.) or a station-config TOML file; repeatable")
     parser.add_argument("--json", action="store_true", help="with --rerun: one JSON object")
-    add_foxglove_argument(parser)
+    add_foxglove_argument(parser, "; the replay then plays headless at --speed (or --max)")
     parser.set_defaults(func=run_replay)
 
 
