@@ -210,18 +210,21 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
                 return
 
     # ------------------------------------------------------------------ closing
-    def close(self) -> None:
-        """Release the overrides (the vehicle's own failsafe takes over), then close. Idempotent.
+    def close(self, release: bool = False) -> None:
+        """Close (idempotent). With `release`, first hand channels 1–8 back to the radio.
 
-        The release is the one send that waits (up to `CLOSE_FLUSH_S`) for the transport to
-        take it: close() is never called inside a tick, and an unsent release would leave
-        3.2.1 flying on the last override until its GCS failsafe.
+        Not by default: whether a release is safe is the flight supervisor's call (a 4.x
+        vehicle in STABILIZE would drop its throttle to the radio's minimum at once), and a
+        link that never sent an override has nothing to release. The release is the one send
+        that waits (up to `CLOSE_FLUSH_S`) for the transport to take it; otherwise whatever is
+        already queued gets the same chance to go out.
         """
         if self._closed:
             return
         self._closed = True
         if self._ep.transport is not None:
-            self.release_overrides()
+            if release:
+                self.release_overrides()
             self._wait_sent(CLOSE_FLUSH_S)
         self._close_connecting()
         self._drop_transport()

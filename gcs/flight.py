@@ -168,11 +168,10 @@ class FlightRunner:
 
     # -------------------------------------------------------------- waiting
     def _why(self, snap: StationSnapshot) -> str:
-        """The supervisor's last reason and the vehicle's last words, for a failure line."""
+        """The supervisor's last reason and the vehicle's recent words, for a failure line."""
         notes = [e.text for e in snap.events if e.text.startswith(f"{snap.state.value}:")]
-        texts = [e.text for e in snap.events if e.text.startswith("vehicle:")]
         why = notes[-1] if notes else f"station {snap.state.value}"
-        return why + (f" ({texts[-1]})" if texts else "")
+        return why + self._vehicle_said(snap)
 
     def _check(self, snap: StationSnapshot) -> None:
         if self.station.error is not None:
@@ -234,8 +233,10 @@ class FlightRunner:
         self.wait("arming", armed_or_refused, self.plan.arm_timeout_s)
 
     @staticmethod
-    def _vehicle_said(snap: StationSnapshot) -> str:
-        texts = [e.text for e in snap.events if e.text.startswith("vehicle:")]
+    def _vehicle_said(snap: StationSnapshot, recent_s: float = 5.0) -> str:
+        """The vehicle's last text if it is recent (an old one explains nothing)."""
+        texts = [e.text for e in snap.events if e.text.startswith("vehicle:")
+                 and snap.t_s - e.t_s <= recent_s]
         return f" ({texts[-1]})" if texts else ""
 
     def fly(self) -> None:

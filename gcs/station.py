@@ -93,8 +93,9 @@ __all__ = [
 ]
 
 LAND_WAIT_STATES = frozenset({SupervisorState.RELEASED, SupervisorState.DISARMED,
-                              SupervisorState.SILENT, SupervisorState.LINK_LOST})
-"""A stopping station may leave once the supervisor is in one of these."""
+                              SupervisorState.SILENT})
+"""A stopping station may leave once the supervisor is in one of these (a lost link first gets
+its LAND requests, then the silence that lets the vehicle's failsafe act)."""
 
 
 class Recorder(Protocol):
@@ -178,6 +179,7 @@ class Station(StationIntents):
         self._estimate: AltEstimate | None = None
         self._out: SupervisorOutput | None = None
         self._link_down_s = 0.0
+        self._out_link = LinkHealth.OK
         self._empty_stats = self.loop.stats()
         self._snapshot = self._make_snapshot(self.clock.now_s(), -1)
         if recorder is not None:
@@ -201,11 +203,16 @@ class Station(StationIntents):
         heartbeat, at most the supervisor's quit timeout); overrides are released only then."""
         alive = self._running and self._thread is not None and self._thread.is_alive()
         flying = self.snapshot(loop_stats=False).state in AIRBORNE_CAPABLE | {
-            SupervisorState.KILLED}
+            SupervisorState.KILLED, SupervisorState.LINK_LOST}
         if alive and flying:
-            self._intents.put(Intent(IntentKind.QUIT))
-            self.wait_for(lambda s: s.state in LAND_WAIT_STATES,
-                          self.supervisor_params.quit_timeout_s)
+            deadline = time.monotonic() + self.supervisor_params.quit_timeout_s
+            # asked again each second: a QUIT is ignored while the link is lost, and the link
+            # may come back with the vehicle still to be landed
+            while time.monotonic() < deadline:
+                self._intents.put(Intent(IntentKind.QUIT))
+                if self.wait_for(lambda s: s.state in LAND_WAIT_STATES,
+                                 min(1.0, deadline - time.monotonic())) is not None:
+                    break
         self.loop.stop()
         if self._thread is not None:
             self._thread.join(timeout_s)
@@ -342,7 +349,10 @@ class Station(StationIntents):
             mocap=pose if isinstance(pose, MocapPose) else None))
         self._out = out
         if out.link is LinkHealth.LOST:
-            self._link_down_s += dt_s
+            # the silence that made it "lost" counts too
+            first = self._out_link is not LinkHealth.LOST and status.frame_age_s < NEVER_S
+            self._link_down_s += dt_s + (status.frame_age_s if first else 0.0)
+        self._out_link = out.link
         self._execute(t_s, out)
         self._record_tick(t_s, k, dt_s, est, records, intents, status, out, at_rest)
         snap = self._make_snapshot(t_s, k)

@@ -31,7 +31,9 @@ from firmware_link.records import Dialect
 class SupervisorParams:
     """Timings in seconds of the station clock, PWM in µs."""
 
-    degraded_after_s: float = 0.3  # 12 ticks of 40 Hz telemetry missing
+    # several frames missing whatever the stream rate (3.2.1 sends ~25 Hz, and a dozen message
+    # types): past this the estimate only extrapolates, and a PID acting on it runs away
+    degraded_after_s: float = 0.15
     # ArduCopter 3.2.1 goes quiet for up to ~1 s while it arms (it recalibrates the barometer
     # in its main loop: the fixture tlog has gaps of 0.85 s and 1.01 s), so 1.5 s, not less
     lost_after_s: float = 1.5

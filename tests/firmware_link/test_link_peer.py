@@ -84,6 +84,7 @@ def test_connect_detects_dialect_and_flies_the_basics(vehicle: FakeVehicle) -> N
         assert not link.armed
         records = link.poll()
         assert any(isinstance(r, CommandAck) and r.command == 400 for r in records)
+        link.close(release=True)
 
     sysid, length, chans = vehicle.state.overrides[0]
     assert sysid == 255
@@ -91,7 +92,7 @@ def test_connect_detects_dialect_and_flies_the_basics(vehicle: FakeVehicle) -> N
     # APM 2.5 must get the 8-channel MAVLink 1 form; 4.x trims trailing zeros of the v2 form.
     assert length == (18 if vehicle.profile == "apm25" else 22)
     assert wait_until(lambda: len(vehicle.state.overrides) >= 2)
-    assert vehicle.state.overrides[-1][2] == (0,) * 8  # close() released the channels
+    assert vehicle.state.overrides[-1][2] == (0,) * 8  # close(release=True) released them
     stats = link.stats
     assert stats.tx_messages == sum(1 for d, _, _ in tapped if d == "tx")
     assert stats.tx_bytes == sum(len(b) for d, _, b in tapped if d == "tx")
@@ -232,6 +233,7 @@ def test_signed_link_works_and_a_strangers_unsigned_frames_are_refused() -> None
             v.inject(bytes(fake.pack(stranger)))
             poll_until(link, lambda rs: link.stats.signature_refusals > refused_before)
             assert link.mode == FlightMode.LAND  # the forged heartbeat changed nothing
+            link.close(release=True)
         # The station signed everything it sent, down to the release on close: the vehicle
         # refused nothing of ours.
         assert wait_until(lambda: "RC_CHANNELS_OVERRIDE" in v.state.rx_types)
@@ -280,15 +282,18 @@ def test_missing_busy_serial_and_silent_peer_are_clear_errors() -> None:
         server.close()
 
 
-def test_context_manager_releases_overrides_when_the_loop_crashes() -> None:
+def test_a_crash_inside_the_context_manager_leaves_the_overrides_as_they_were() -> None:
+    # releasing is the supervisor's decision: on 4.x it drops the throttle to the radio's
+    # minimum, so a link that goes away on an exception must not do it by itself
     v = FakeVehicle("apm25").start()
     try:
         with pytest.raises(RuntimeError), VehicleLink.open(v.url) as link:
             link.rc_override(RcCommand(throttle_us=1400))
             raise RuntimeError("loop crashed")
-        assert wait_until(lambda: len(v.state.overrides) >= 2)
-        assert v.state.overrides[-1][2] == (0,) * 8
-        link.close()  # idempotent
+        assert wait_until(lambda: len(v.state.overrides) >= 1)
+        assert all(chans[2] == 1400 for _sys, _n, chans in v.state.overrides)
+        link.close(release=True)  # idempotent: closed already, nothing more is sent
+        assert all(chans[2] == 1400 for _sys, _n, chans in v.state.overrides)
     finally:
         v.stop()
 
