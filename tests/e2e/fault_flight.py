@@ -122,7 +122,8 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
         if t_fault is not None:
             end = t_fault + (case.duration_s + 25.0) / speedup
             while time.monotonic() < end and not _disarmed_after(watch_udp, t_fault):
-                time.sleep(0.1)
+                time.sleep(0.1)  # polling a condition with a deadline
+            # two more seconds of motion capture after the disarm: the touchdown's samples
             time.sleep(min(2.0, max(0.0, end - time.monotonic())))
         params = watch_udp.request_params(("FS_GCS_ENABLE", "FS_GCS_TIMEOUT"), 3.0)
         clock = SimClockMap(watch_mocap.mocap)
