@@ -14,64 +14,28 @@ moment it connects; what clients send is ignored.
 from __future__ import annotations
 
 import math
-import socket
 from collections.abc import Sequence
 
+from sitl.link.broadcast import BroadcastServer
 from sitl.link.codec import MavCodec, mavlink
-from sitl.link.endpoints import listen_tcp
 from sitl.simulation import VehicleRuntime
 
 TRUTH_SYSID = 201
 TRUTH_RATE_HZ = 50.0  # above the station's 40 Hz loop, so every tick has a fresh report
-CLIENT_BACKLOG_BYTES = 65536
 
 
-class TruthServer:
+class TruthServer(BroadcastServer):
     """TCP server broadcasting each vehicle's true position and velocity."""
 
     def __init__(self, port: int, mavlink1: bool, host: str = "127.0.0.1",
                  rate_hz: float = TRUTH_RATE_HZ) -> None:
         if not rate_hz > 0.0:
             raise ValueError(f"rate_hz {rate_hz} must be > 0")
-        self._listener = listen_tcp(host, port, backlog=4, what="truth tcp")
-        self.host = host
-        self.port = self._listener.getsockname()[1]
+        super().__init__(host, port, "truth tcp", nodelay=True)
         self._codec = MavCodec(TRUTH_SYSID, 1, mavlink1)
-        self._clients: dict[int, tuple[socket.socket, bytearray]] = {}
         self._period_s = 1.0 / rate_hz
         self._next_s: float | None = None  # the next report's time, on the rate's grid
         self.sent = 0
-
-    def fileno_list(self) -> list[int]:
-        """Descriptors to watch."""
-        return [self._listener.fileno(), *self._clients]
-
-    def on_readable(self, fd: int) -> None:
-        """Accept a client, or read (and ignore) what one sent; notice a hang-up."""
-        if fd == self._listener.fileno():
-            try:
-                conn, _ = self._listener.accept()
-            except OSError:
-                return
-            conn.setblocking(False)
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self._clients[conn.fileno()] = (conn, bytearray())
-            return
-        entry = self._clients.get(fd)
-        if entry is None:
-            return
-        try:
-            data = entry[0].recv(4096)
-        except BlockingIOError:
-            return
-        except OSError:
-            data = b""
-        if not data:
-            self._drop(fd)
-
-    def _drop(self, fd: int) -> None:
-        conn, _ = self._clients.pop(fd)
-        conn.close()
 
     def publish(self, t_s: float, vehicles: Sequence[VehicleRuntime]) -> None:
         """After a simulation tick at `t_s`: queue a report of every vehicle when one is due,
@@ -97,30 +61,4 @@ class TruthServer:
             )
             data += self._codec.encode(msg)
             self.sent += 1
-        for _conn, pending in self._clients.values():
-            if len(pending) < CLIENT_BACKLOG_BYTES:
-                pending += data
-
-    def _send(self) -> None:
-        for fd in list(self._clients):
-            conn, pending = self._clients[fd]
-            if not pending:
-                continue
-            try:
-                n = conn.send(pending)
-            except BlockingIOError:
-                continue
-            except OSError:
-                self._drop(fd)
-                continue
-            del pending[:n]
-
-    def describe(self) -> str:
-        """The address printed on stdout."""
-        return f"tcp:{self.host}:{self.port}"
-
-    def close(self) -> None:
-        """Close every socket."""
-        for fd in list(self._clients):
-            self._drop(fd)
-        self._listener.close()
+        self._queue_all(data)
