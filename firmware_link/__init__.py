@@ -14,13 +14,15 @@ and `rc_override` return at once (sends never block: see `tx_queue`) and the out
 CommandAck / Heartbeat records. Link health: `lost` (no frame of any kind for 1.5 s),
 `last_rx_s`, `last_heartbeat_s`; `set_gcs_heartbeat(False)` silences the station's heartbeat so
 the vehicle's own GCS failsafe can act. Errors are `LinkError` (exit 1; `ParamError` for
-parameters) or `LinkUsageError` (exit 2), one line each. `.parm` files: `parm_file`.
+parameters) or `LinkUsageError` (exit 2), one line each. `.parm` files: `parm_file`. Other
+ground stations watching through this one: `forward.Forwarder`.
 """
 
 from firmware_link.connection import ConnectionSpec, Transport, parse_connection_string
 from firmware_link.dialect import dialect_of_frame
 from firmware_link.errors import LinkError, LinkUsageError
 from firmware_link.firmware import FirmwareInfo
+from firmware_link.forward import Forwarder, ForwardPort, ForwardStats
 from firmware_link.mocap_link import MocapLink
 from firmware_link.params import ParamError
 from firmware_link.parm_file import (
@@ -52,6 +54,9 @@ __all__ = [
     "ConnectionSpec",
     "DataStream",
     "FirmwareInfo",
+    "ForwardPort",
+    "ForwardStats",
+    "Forwarder",
     "LinkError",
     "LinkStats",
     "LinkUsageError",

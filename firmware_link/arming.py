@@ -70,6 +70,7 @@ class ArmingAndModes:
 
     _ep: Any
     _clock: Callable[[], float]
+    _last_stick_s: float
     _target_system: int
     _target_component: int
     _statustexts: Any
@@ -96,10 +97,12 @@ class ArmingAndModes:
             clamp_pwm_us(cmd.throttle_us),
             clamp_pwm_us(cmd.yaw_us),
         ] + [RC_LEAVE_ALONE] * 4
+        self._last_stick_s = self._clock()
         return self._override(chans)
 
     def release_overrides(self) -> bool:
         """Hand channels 1–8 back to the radio (0 = release), so the vehicle's failsafe rules."""
+        self._last_stick_s = -math.inf
         return self._override([RC_RELEASE] * 8)
 
     def _override(self, chans: list[int]) -> bool:

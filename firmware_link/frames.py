@@ -50,6 +50,23 @@ class _Parser(mavlink.MAVLink):
         return bool(super().check_signature(msgbuf, srcSystem, srcComponent))
 
 
+class RawFrame:
+    """A frame packed elsewhere (a forwarded station's), sent byte for byte: no sequence
+    number or signature of this link's goes on it."""
+
+    __slots__ = ("data",)
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+
+
+def make_parser(source_system: int, source_component: int) -> Any:
+    """A robust parser (garbage comes back as BAD_DATA) that checks signatures first."""
+    parser = _Parser(_NoFile(), source_system, source_component)
+    parser.robust_parsing = True
+    return parser
+
+
 class FrameEndpoint:
     """Decoded messages from a transport, and encoded messages to it, with stats and a tap."""
 
@@ -66,8 +83,7 @@ class FrameEndpoint:
         self.tally = StatsTally()
         self._clock = clock
         self._on_raw = on_raw
-        self.parser = _Parser(_NoFile(), source_system, source_component)
-        self.parser.robust_parsing = True
+        self.parser = make_parser(source_system, source_component)
         self._encoder_v1 = mavlink1.MAVLink(_NoFile(), source_system, source_component)
         self.wire = WireVersion.V1
         self.tx = TxQueue()
@@ -158,6 +174,16 @@ class FrameEndpoint:
         self.flush()
         return True
 
+    def send_raw(self, frame: bytes) -> bool:
+        """Queue a frame packed elsewhere, in order with this link's own messages."""
+        if not self._can_send():
+            return False
+        if not self.tx.put(RawFrame(frame), len(frame)):
+            self.tally.tx_dropped += 1
+            return False
+        self.flush()
+        return True
+
     def flush(self) -> int:
         """Write what waits, as far as the transport takes it now; the bytes still waiting."""
         transport = self.transport
@@ -175,11 +201,14 @@ class FrameEndpoint:
         self.tally.tx_dropped += self.tx.clear()
 
     def _pack(self, msg: Any) -> bytes:
-        encoder = self.encoder
-        frame = bytes(msg.pack(encoder))
-        encoder.seq = (encoder.seq + 1) % 256
-        # Both encoders share one sequence so a dialect switch never looks like a gap.
-        self._encoder_v1.seq = self.parser.seq = encoder.seq
+        if isinstance(msg, RawFrame):
+            frame = msg.data
+        else:
+            encoder = self.encoder
+            frame = bytes(msg.pack(encoder))
+            encoder.seq = (encoder.seq + 1) % 256
+            # Both encoders share one sequence so a dialect switch never looks like a gap.
+            self._encoder_v1.seq = self.parser.seq = encoder.seq
         self.tally.tx_messages += 1
         self.tally.tx_bytes += len(frame)
         if self._on_raw is not None:

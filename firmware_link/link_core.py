@@ -20,6 +20,7 @@ from typing import Any
 from firmware_link.connection import ConnectionSpec
 from firmware_link.convert import RecordConverter, text_field
 from firmware_link.firmware import FirmwareEvidence, FirmwareInfo, decide_firmware
+from firmware_link.forward import ForwardPort
 from firmware_link.frames import FrameEndpoint
 from firmware_link.protocol import message_id
 from firmware_link.records import (
@@ -39,6 +40,9 @@ MAV_TYPE_GCS = 6
 MAV_AUTOPILOT_INVALID = 8
 MAV_STATE_ACTIVE = 4
 RC_OVERRIDE_CHANNELS = 8
+# The station counts as the sticks' writer this long after its last override (it sends one
+# every 25 ms); a forwarded station's overrides pass only when it has stopped for longer.
+STICKS_OWNED_S = 1.0
 MAV_CMD_SET_MESSAGE_INTERVAL = 511
 
 
@@ -59,8 +63,11 @@ class LinkCore(TransportUpkeep):
         clock: Callable[[], float],
         wall_clock: Callable[[], float],
         signing_key: bytes | None,
+        forward: ForwardPort | None = None,
     ) -> None:
         self.spec = spec
+        self._forward = forward
+        self._last_stick_s = -math.inf
         self._ep = endpoint
         self._clock = clock
         self._wall_clock = wall_clock
@@ -186,6 +193,8 @@ class LinkCore(TransportUpkeep):
                 msgs = []
             for msg in msgs:
                 self._dispatch(msg, now)
+            if self._forward is not None:
+                self._forward_frames(msgs, now)
         self._watchdog(now)
         if self._gcs_heartbeat and now >= self._next_gcs_hb_s:
             self._send_gcs_heartbeat(now)
@@ -213,6 +222,31 @@ class LinkCore(TransportUpkeep):
                 self._statustexts.append(record)
                 self._evidence.statustext(record.text)
             self._pending.append(record)
+
+    def _forward_frames(self, msgs: list[Any], now: float) -> None:
+        """The vehicle's frames out to the forwarded stations; theirs in, as policy allows."""
+        assert self._forward is not None
+        for msg in msgs:
+            self._forward.to_stations(bytes(msg.get_msgbuf()))
+        frames, notes = self._forward.from_stations(
+            now_s=now,
+            sticks_owned=now - self._last_stick_s < STICKS_OWNED_S,
+            silent=not self._gcs_heartbeat,
+            signing_key=self._signing_key if self._signing else None,
+        )
+        for frame in frames:
+            try:
+                self._ep.send_raw(frame)
+            except TransportClosed as exc:
+                self._transport_lost(now, str(exc))
+                break
+        for note in notes:
+            self._event(now, LinkEventKind.FORWARD, note)
+
+    @property
+    def forward(self) -> ForwardPort | None:
+        """The forwarded stations' side of this link (None without `--forward`)."""
+        return self._forward
 
     def _on_any_frame(self, now: float) -> None:
         self._last_rx_s = now

@@ -262,6 +262,7 @@ class LinkEventKind(enum.Enum):
     DIALECT = "dialect"
     SIGNING = "signing"
     STREAMS = "streams"
+    FORWARD = "forward"  # a forwarded station's frame was refused (firmware_link.forward)
 
 
 @dataclass(frozen=True, slots=True)

@@ -28,6 +28,7 @@ from firmware_link.connection import parse_connection_string
 from firmware_link.dialect import MAVLINK1_CANNOT_SIGN
 from firmware_link.errors import LinkError, LinkUsageError
 from firmware_link.firmware import decide_firmware
+from firmware_link.forward import ForwardPort
 from firmware_link.frames import FrameEndpoint, RawTap
 from firmware_link.identify import Identification
 from firmware_link.link_core import MAV_AUTOPILOT_INVALID, MAV_TYPE_GCS, LinkCore
@@ -62,9 +63,11 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
         connect_timeout_s: float = 1.0,
         wall_clock: Callable[[], float] = time.time,
         identify: bool = True,
+        forward: ForwardPort | None = None,
     ) -> VehicleLink:
         """Open `url` and return once a vehicle heartbeat was seen and (with `identify`) its
-        firmware found out; LinkError otherwise."""
+        firmware found out; LinkError otherwise. With `forward`, other ground stations hear
+        the vehicle from the first frame (`firmware_link.forward`)."""
         spec = parse_connection_string(url)
         for name, value in (("source_system", source_system), ("target_system", target_system)):
             if value is not None and not 1 <= value <= 255:
@@ -79,7 +82,8 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
             clock=clock,
             on_raw=on_raw,
         )
-        link = cls(spec, endpoint, clock=clock, wall_clock=wall_clock, signing_key=signing_key)
+        link = cls(spec, endpoint, clock=clock, wall_clock=wall_clock, signing_key=signing_key,
+                   forward=forward)
         if signing_key is not None:
             # Only MAVLink 2 can sign: greet signed, but hear unsigned frames until the
             # firmware is known (an APM 2.5 must be told plainly that it cannot sign).

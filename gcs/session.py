@@ -15,7 +15,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from firmware_link import LinkUsageError, MocapLink, ParamError, VehicleLink, load_signing_key
+from firmware_link import (
+    Forwarder,
+    LinkUsageError,
+    MocapLink,
+    ParamError,
+    VehicleLink,
+    load_signing_key,
+)
 from firmware_link.records import Battery, Dialect, MocapPose
 from firmware_link.truth_link import TruthLink, TruthRecorder
 from gcs.clock import Clock, MonotonicClock, ScaledClock
@@ -57,6 +64,7 @@ class SessionOptions:
     metadata: dict[str, Any] = field(default_factory=dict)
     fix_failsafe: bool = False  # the pilot's consent to set unsafe failsafe parameters
     foxglove: str | None = None  # [HOST:]PORT: serve the flight live to Foxglove
+    forward: tuple[str, ...] = ()  # other ground stations' URLs (firmware_link.forward)
 
     def validate(self) -> None:
         """Reject impossible combinations with one line each."""
@@ -118,6 +126,7 @@ class StationSession:
         self.sitl_endpoints: Any = None
         self.preflight: dict[int, PreflightReport] = {}
         self.live: Any = None  # logs.live.LiveView with --foxglove
+        self.forwarder: Forwarder | None = None
         self._stack = contextlib.ExitStack()
 
     def __enter__(self) -> StationSession:
@@ -182,6 +191,10 @@ class StationSession:
             self._stack.callback(self.live.close)
             # before any screen is up (teleop's starts once the session is ready)
             print(f"foxglove: live view on {self.live.url}", file=sys.stderr, flush=True)
+        if o.forward:
+            self.forwarder = Forwarder.open(o.forward)
+            self._stack.callback(self.forwarder.close)
+            print(f"forward: {', '.join(self.forwarder.urls)}", file=sys.stderr, flush=True)
         for sysid, url in urls.items():
             self.vehicles[sysid] = self._open_vehicle(sysid, url, mocap_url, key, config)
         truth_url = getattr(self.sitl_endpoints, "truth", None)
@@ -209,9 +222,13 @@ class StationSession:
             world = o.world if o.world is not None or o.connect is not None else DEFAULT_WORLD
             sink = FoxgloveFeed(recorder, self.live, sysid=sysid, boxes=world_boxes(world),
                                 live_prefix=f"/v{sysid}" if len(o.sysids) > 1 else "")
+        # one vehicle takes every forwarded frame; several share them out by target system
+        forward = (self.forwarder.port(sysid if len(o.sysids) > 1 else None)
+                   if self.forwarder is not None else None)
         link = VehicleLink.open(url, signing_key=key, clock=self.clock.now_s,
                                 target_system=sysid if o.connect is None else None,
-                                on_raw=sink.put_raw if sink is not None else None)
+                                on_raw=sink.put_raw if sink is not None else None,
+                                forward=forward)
         self._stack.callback(link.close)
         link.bring_up(STREAM_RATE_HZ)
         # The throttle curve is how the station turns a thrust into a stick: a default in place

@@ -30,7 +30,17 @@ def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
                    help="let the station set the vehicle's GCS failsafe parameters when the "
                         "pre-flight checks find them unsafe (FS_GCS_ENABLE, FS_GCS_TIMEOUT); "
                         "without it such a vehicle is refused")
+    add_forward_argument(p)
     add_foxglove_argument(p)
+
+
+def add_forward_argument(p: argparse.ArgumentParser) -> None:
+    """--forward URL (repeatable): other ground stations watching through this one."""
+    p.add_argument("--forward", metavar="URL", action="append", default=[],
+                   help="let another ground station (QGroundControl, Mission Planner, MAVProxy) "
+                        "share the vehicle: udpout:HOST:PORT, udpin:HOST:PORT or "
+                        "tcpin:HOST:PORT; every vehicle frame goes out unchanged, its frames "
+                        "go to the vehicle except RC overrides while quadgcs flies; repeatable")
 
 
 def add_foxglove_argument(p: argparse.ArgumentParser, note: str = "") -> None:
@@ -49,4 +59,5 @@ def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
         seed=args.seed, config=args.config, signing_key=args.signing_key, record=args.record,
         output=args.output, fix_failsafe=getattr(args, "fix_failsafe", False),
         foxglove=getattr(args, "foxglove", None),
+        forward=tuple(getattr(args, "forward", None) or ()),
     )
