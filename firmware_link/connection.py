@@ -32,6 +32,7 @@ class Transport(enum.Enum):
     UDPIN = "udpin"
     UDPOUT = "udpout"
     TCP = "tcp"
+    MEMORY = "mem"  # an in-memory pipe to a simulator in this process (firmware_link.memory)
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,6 +85,11 @@ def parse_connection_string(url: str) -> ConnectionSpec:
         if port == 0 and transport is not Transport.UDPIN:
             raise LinkUsageError(f"connection string {url!r}: port 0 cannot be connected to")
         return ConnectionSpec(url=text, transport=transport, host=host, port=port)
+    if sep and scheme == Transport.MEMORY.value:
+        if not rest or any(ch.isspace() for ch in rest):
+            raise LinkUsageError(f"connection string {url!r}: expected mem:NAME of an in-memory "
+                                 "port (a lockstep simulator in this process)")
+        return ConnectionSpec(url=text, transport=Transport.MEMORY, host=rest)
     if text.startswith("/") or text.upper().startswith("COM"):
         device, comma, baud_text = text.partition(",")
         baud = DEFAULT_BAUD

@@ -354,4 +354,8 @@ def open_transport(spec: ConnectionSpec, connect_timeout_s: float = 1.0) -> Byte
         return TcpTransport.connect(spec, connect_timeout_s)
     if spec.transport is Transport.SERIAL:
         return SerialTransport.open(spec)
+    if spec.transport is Transport.MEMORY:
+        from firmware_link.memory import MemoryTransport  # it imports this module
+
+        return MemoryTransport.open(spec)
     return UdpTransport.open(spec)

@@ -138,8 +138,12 @@ class FlightRunner:
 
     def __init__(self, station: Station, plan: FlightPlan,
                  on_progress: Callable[[StationSnapshot, Phase], None] | None = None,
-                 rest_alt_m: float | None = None) -> None:
+                 rest_alt_m: float | None = None,
+                 idle: Callable[[], None] | None = None) -> None:
         self.station = station
+        # between looks at the station: sleep while its loop thread flies, or (lockstep) run
+        # its next tick, the simulation included
+        self._idle = idle or (lambda: time.sleep(POLL_S))
         # the truth's vertical origin is whatever the vehicle reported first; the flight starts
         # on the floor, where the centre of gravity is known to stand at rest_alt_m
         self.rest_alt_m = (station.config.estimator.rest_alt_m if rest_alt_m is None
@@ -198,7 +202,7 @@ class FlightRunner:
             if clock.now_s() >= deadline:
                 raise FlightFailed(f"{what} did not happen within {timeout_s:g} s "
                                    f"({self._why(snap)})")
-            time.sleep(POLL_S)
+            self._idle()
 
     def pause(self, seconds: float) -> None:
         """Let `seconds` pass on the station's clock, watching for trouble."""
@@ -209,7 +213,7 @@ class FlightRunner:
             self._check(snap)
             if self._on_progress is not None:
                 self._on_progress(snap, self.phase)
-            time.sleep(POLL_S)
+            self._idle()
 
     # -------------------------------------------------------------- the flight
     def arm(self) -> None:

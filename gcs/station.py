@@ -22,7 +22,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import Any
 
 from firmware_link.errors import LinkUsageError
 from firmware_link.records import (
@@ -30,14 +30,12 @@ from firmware_link.records import (
     Barometer,
     CommandAck,
     Dialect,
-    FlightMode,
     Heartbeat,
     Imu,
     LinkEvent,
     LinkEventKind,
     MocapPose,
     Rangefinder,
-    RcCommand,
     SimTruth,
     StatusText,
     TelemetryRecord,
@@ -56,11 +54,14 @@ from gcs.station_types import (
     NEVER_S,
     ControlMode,
     EventLevel,
+    LinkLike,
     LoopSample,
+    Recorder,
     StationEvent,
     StationSetup,
     StationSnapshot,
     TickInputs,
+    control_mode,
 )
 from gcs.supervisor import (
     AIRBORNE_CAPABLE,
@@ -98,38 +99,8 @@ LAND_WAIT_STATES = frozenset({SupervisorState.RELEASED, SupervisorState.DISARMED
 its LAND requests, then the silence that lets the vehicle's failsafe act)."""
 
 
-class Recorder(Protocol):
-    """What the station needs of a recorder (logs.recorder.Recorder has these)."""
-
-    def put(self, topic: str, t_s: float, payload: Any) -> None: ...
-
-    def put_raw(self, direction: str, t_s: float, data: bytes) -> None: ...
-
-
-class LinkLike(Protocol):
-    """The subset of firmware_link.VehicleLink the station uses."""
-
-    def poll(self) -> list[TelemetryRecord]: ...
-    def rc_override(self, cmd: RcCommand) -> bool: ...
-    def release_overrides(self) -> bool: ...
-    def send_arm(self, force: bool = False) -> bool: ...
-    def send_disarm(self, force: bool = False) -> bool: ...
-    def send_set_mode(self, mode: FlightMode | int) -> bool: ...
-
-    @property
-    def lost(self) -> bool: ...
-
-    @property
-    def stats(self) -> Any: ...
-
-
-def control_mode(state: SupervisorState, position: bool) -> ControlMode:
-    """The display's view of who makes the throttle."""
-    if state is SupervisorState.KILLED:
-        return ControlMode.KILLED
-    if state in (SupervisorState.SPOOL_UP, SupervisorState.TAKEOFF, SupervisorState.HOLD):
-        return ControlMode.POSITION if position else ControlMode.ALT_HOLD
-    return ControlMode.MANUAL
+LAND_UNTIL = AIRBORNE_CAPABLE | {SupervisorState.KILLED, SupervisorState.LINK_LOST}
+"""States in which a stopping station lands the vehicle before it lets go."""
 
 
 class Station(StationIntents):
@@ -169,6 +140,7 @@ class Station(StationIntents):
         self._events: deque[StationEvent] = deque(maxlen=self.config.events_kept)
         self._latest: dict[type, TelemetryRecord] = {}
         self._thread: threading.Thread | None = None
+        self._stepped = False  # run by run_tick() on the caller's thread (lockstep)
         self._running = False
         self._error: BaseException | None = None
         self._listeners: list[Callable[[StationSnapshot], None]] = []
@@ -198,12 +170,53 @@ class Station(StationIntents):
         self._thread = threading.Thread(target=self._run, name="station-loop", daemon=True)
         self._thread.start()
 
+    def run_tick(self) -> None:
+        """Run the next tick on the calling thread instead of the loop thread (a lockstep
+        flight: waiting for the tick's deadline is the clock running the simulation to it).
+        An exception in the tick ends the station as it would end the loop thread."""
+        if self._thread is not None:
+            raise RuntimeError("station runs its own loop thread")
+        if self._error is not None:
+            raise RuntimeError(f"control loop stopped: {self._error}")
+        self._stepped = self._running = True
+        try:
+            self.loop.run(max_ticks=1)
+        except BaseException as exc:
+            self._error = exc
+            self._event(self.clock.now_s(), EventLevel.ERROR,
+                        f"control loop stopped: {type(exc).__name__}: {exc}")
+            self._finish()
+            raise
+
+    def _stop_stepped(self) -> None:
+        """`stop()` of a station run by `run_tick`: land it on ticks of its own clock."""
+        if self._error is None and self.snapshot(loop_stats=False).state in LAND_UNTIL:
+            deadline = self.clock.now_s() + self.supervisor_params.quit_timeout_s
+            next_ask = self.clock.now_s()
+            while self.clock.now_s() < deadline:
+                if self.clock.now_s() >= next_ask:  # asked again each second, as below
+                    self._intents.put(Intent(IntentKind.QUIT))
+                    next_ask += 1.0
+                self.run_tick()
+                if self.snapshot(loop_stats=False).state in LAND_WAIT_STATES:
+                    break
+        self._finish()
+
+    def _finish(self) -> None:
+        self._let_go()
+        self._running = False
+        with self._lock:
+            self._snapshot = self._make_snapshot(self.clock.now_s(), self._snapshot.tick)
+
     def stop(self, timeout_s: float = 2.0) -> None:
         """Stop the loop. A vehicle that may be flying is landed first (LAND confirmed by a
         heartbeat, at most the supervisor's quit timeout); overrides are released only then."""
+        if self._stepped:
+            if self._running:
+                self._stop_stepped()
+            return
         alive = self._running and self._thread is not None and self._thread.is_alive()
-        flying = self.snapshot(loop_stats=False).state in AIRBORNE_CAPABLE | {
-            SupervisorState.KILLED, SupervisorState.LINK_LOST}
+        flying = self.snapshot(loop_stats=False).state in LAND_UNTIL
         if alive and flying:
             deadline = time.monotonic() + self.supervisor_params.quit_timeout_s
             # asked again each second: a QUIT is ignored while the link is lost, and the link
@@ -259,10 +272,7 @@ class Station(StationIntents):
                         f"control loop stopped: {type(exc).__name__}: {exc}")
             self._emergency_land()
         finally:
-            self._let_go()
-            self._running = False
-            with self._lock:
-                self._snapshot = self._make_snapshot(self.clock.now_s(), self._snapshot.tick)
+            self._finish()
 
     def _let_go(self) -> None:
         """Release the overrides only where that cannot drop a flying vehicle."""

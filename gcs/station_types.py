@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from firmware_link.records import (
     Attitude,
+    FlightMode,
     Heartbeat,
     Imu,
     MocapPose,
@@ -135,3 +136,37 @@ class TickInputs:
     frame_age_s: float
     state: SupervisorState  # after the tick
     link_lost: bool
+
+
+class Recorder(Protocol):
+    """What the station needs of a recorder (logs.recorder.Recorder has these)."""
+
+    def put(self, topic: str, t_s: float, payload: Any) -> None: ...
+
+    def put_raw(self, direction: str, t_s: float, data: bytes) -> None: ...
+
+
+class LinkLike(Protocol):
+    """The subset of firmware_link.VehicleLink the station uses."""
+
+    def poll(self) -> list[TelemetryRecord]: ...
+    def rc_override(self, cmd: RcCommand) -> bool: ...
+    def release_overrides(self) -> bool: ...
+    def send_arm(self, force: bool = False) -> bool: ...
+    def send_disarm(self, force: bool = False) -> bool: ...
+    def send_set_mode(self, mode: FlightMode | int) -> bool: ...
+
+    @property
+    def lost(self) -> bool: ...
+
+    @property
+    def stats(self) -> Any: ...
+
+
+def control_mode(state: SupervisorState, position: bool) -> ControlMode:
+    """The display's view of who makes the throttle."""
+    if state is SupervisorState.KILLED:
+        return ControlMode.KILLED
+    if state in (SupervisorState.SPOOL_UP, SupervisorState.TAKEOFF, SupervisorState.HOLD):
+        return ControlMode.POSITION if position else ControlMode.ALT_HOLD
+    return ControlMode.MANUAL

@@ -4,7 +4,8 @@ Streams ATT_POS_MOCAP for every tracked vehicle as each pose is delivered (100 H
 world's latency), from system id 200 with component id = the tracked vehicle's system id, so a
 station can tell vehicles apart on one connection. Any number of clients may connect; each gets
 every pose from the moment it connects. It sends no HEARTBEAT and ignores what clients send
-(a station's heartbeat only tells a server where it is).
+(a station's heartbeat only tells a server where it is). `MocapEncoder` makes the bytes, so the
+in-memory lockstep endpoint (`sitl.lockstep`) sends exactly what the socket does.
 """
 
 from __future__ import annotations
@@ -16,18 +17,15 @@ from sitl.simulation import MocapFrame
 MOCAP_SYSID = 200
 
 
-class MocapServer(BroadcastServer):
-    """TCP server broadcasting ATT_POS_MOCAP."""
+class MocapEncoder:
+    """ATT_POS_MOCAP frames of delivered poses, one sequence for every listener."""
 
-    def __init__(self, port: int, mavlink1: bool, host: str = "127.0.0.1") -> None:
-        super().__init__(host, port, "mocap tcp")
+    def __init__(self, mavlink1: bool) -> None:
         self._codec = MavCodec(MOCAP_SYSID, 1, mavlink1)
         self.sent = 0
 
-    def publish(self, frames: list[MocapFrame]) -> None:
-        """Encode and queue poses for every client, then send what the sockets take."""
-        if not self._clients:
-            return
+    def encode(self, frames: list[MocapFrame]) -> bytes:
+        """The frames of `frames`, in order."""
         data = bytearray()
         for f in frames:
             s = f.sample
@@ -37,5 +35,24 @@ class MocapServer(BroadcastServer):
             )
             data += self._codec.encode(msg)
             self.sent += 1
-        self._queue_all(data)
+        return bytes(data)
+
+
+class MocapServer(BroadcastServer):
+    """TCP server broadcasting ATT_POS_MOCAP."""
+
+    def __init__(self, port: int, mavlink1: bool, host: str = "127.0.0.1") -> None:
+        super().__init__(host, port, "mocap tcp")
+        self._encoder = MocapEncoder(mavlink1)
+
+    @property
+    def sent(self) -> int:
+        """Poses encoded so far."""
+        return self._encoder.sent
+
+    def publish(self, frames: list[MocapFrame]) -> None:
+        """Encode and queue poses for every client, then send what the sockets take."""
+        if not self._clients:
+            return
+        self._queue_all(self._encoder.encode(frames))
         self._send()

@@ -45,6 +45,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "same speed-up")
     p.add_argument("--takeoff-delay", type=float, default=0.0, metavar="S",
                    help="stay armed on the floor this long before taking off (default 0)")
+    p.add_argument("--lockstep", action="store_true",
+                   help="fly the bundled SITL in this process on simulated time, as fast as the "
+                        "CPU allows and the same flight for the same --seed (no --connect)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--live", action="store_true", help="print telemetry lines while flying")
     p.set_defaults(func=run)
@@ -180,29 +183,44 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError("--speedup applies to a simulator on this machine only (loopback or a "
                          "pseudo-terminal); a vehicle at --connect flies in real time")
     options = session_options(args, "fly")
-    with StationSession(options) as session:
-        v = session.first
-        with contextlib.suppress(ValueError):  # not the main thread (tests): no handlers
-            signal.signal(signal.SIGTERM, _on_sigterm)
-            signal.signal(signal.SIGQUIT, lambda _n, _f: v.station.kill())
+    if getattr(args, "lockstep", False):
+        from gcs.lockstep_session import LockstepSession
+
+        session: StationSession = LockstepSession(options)
+    else:
+        session = StationSession(options)
+    with session:
+        return fly_session(session, plan, live=args.live)
+
+
+def fly_session(session: StationSession, plan: FlightPlan, live: bool = False) -> dict[str, Any]:
+    """Fly `plan` on an open session's first vehicle (a lockstep session runs its ticks from
+    here); the summary dict, or FlightFailed."""
+    v = session.first
+    lockstep = hasattr(session, "tick")
+    with contextlib.suppress(ValueError):  # not the main thread (tests): no handlers
+        signal.signal(signal.SIGTERM, _on_sigterm)
+        signal.signal(signal.SIGQUIT, lambda _n, _f: v.station.kill())
+    if not lockstep:
         v.station.start()
-        printer = LivePrinter(session.clock) if args.live else None
-        runner = FlightRunner(v.station, plan, printer)
-        path = str(v.recorder.path) if v.recorder is not None else None
-        try:
-            runner.fly()
-        except FlightFailed as exc:
-            snap = v.station.snapshot(loop_stats=False)
-            raise FlightFailed(f"{exc}; link down {snap.link_down_s:.1f} s; recording "
-                               f"{path or 'off'}") from None
-        d = _summary_dict(runner.summary(v.truth_series()), path, v.link.dialect)
-        d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
-        d["status"] = "ok"
-        rms = d.get("rms_error_m")
-        if not isinstance(rms, float) or not math.isfinite(rms) or rms > ABSURD_RMS_M:
-            raise FlightFailed(f"hold error {rms} m is not a flight that went as commanded "
-                               f"(over {ABSURD_RMS_M} m or unknown); recording {path or 'off'}")
-        return d
+    printer = LivePrinter(session.clock) if live else None
+    runner = FlightRunner(v.station, plan, printer,
+                          idle=getattr(session, "tick", None))
+    path = str(v.recorder.path) if v.recorder is not None else None
+    try:
+        runner.fly()
+    except FlightFailed as exc:
+        snap = v.station.snapshot(loop_stats=False)
+        raise FlightFailed(f"{exc}; link down {snap.link_down_s:.1f} s; recording "
+                           f"{path or 'off'}") from None
+    d = _summary_dict(runner.summary(v.truth_series()), path, v.link.dialect)
+    d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
+    d["status"] = "ok"
+    rms = d.get("rms_error_m")
+    if not isinstance(rms, float) or not math.isfinite(rms) or rms > ABSURD_RMS_M:
+        raise FlightFailed(f"hold error {rms} m is not a flight that went as commanded "
+                           f"(over {ABSURD_RMS_M} m or unknown); recording {path or 'off'}")
+    return d
 
 
 def run(args: argparse.Namespace) -> int:

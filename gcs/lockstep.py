@@ -1,0 +1,123 @@
+"""Lockstep flights: the station and the bundled SITL in one process, on one simulated clock.
+
+Over TCP the SITL is a separate program that keeps its own time; in lockstep it is a library
+whose time the station drives (`sitl.lockstep`): `LockstepClock.sleep_until(t)` is the
+simulation running up to `t`, so the loop's wait for its next tick, the link's wait for bytes
+and a flight's wait for the vehicle all cost only the CPU the simulation needs. Nothing waits on
+the wall clock and no thread is involved, so a seed flies the same flight bit for bit.
+
+The station still learns everything from MAVLink bytes: the SITL's ports are plugged in as
+`mem:` connection strings (`firmware_link.memory`) and the station opens them with the same
+`VehicleLink`, `MocapLink` and `TruthLink` it uses over TCP. The SITL is loaded by name, as
+`SitlProcess` starts it by name: nothing else of it is imported.
+"""
+
+from __future__ import annotations
+
+import importlib
+import itertools
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from firmware_link import memory
+from firmware_link.truth_link import TruthLink, TruthReport
+from gcs.errors import UsageError
+
+_instances = itertools.count(1)
+
+
+class Timeline(Protocol):
+    """What the clock needs of a lockstep simulator."""
+
+    @property
+    def t_s(self) -> float: ...
+
+    def advance_to(self, t_s: float) -> None: ...
+
+
+class LockstepClock:
+    """A `Clock` whose waiting runs the simulation: time passes only as fast as it computes."""
+
+    def __init__(self, timeline: Timeline) -> None:
+        self.timeline = timeline
+
+    def now_s(self) -> float:
+        """The simulated time."""
+        return self.timeline.t_s
+
+    def sleep_until(self, t_s: float) -> None:
+        """Run the simulation up to `t_s`."""
+        self.timeline.advance_to(t_s)
+
+
+@dataclass(frozen=True, slots=True)
+class LockstepOptions:
+    """What to ask the bundled SITL for (as `SitlOptions` asks the program)."""
+
+    profile: str = "apm25"
+    world: Any = None  # a world TOML path, an already loaded world, or None (empty room)
+    vehicles: int = 1
+    seed: int = 0
+    noise: bool = True
+    truth: bool = False
+    signing_key: bytes | None = None
+
+
+class BundledLockstep:
+    """The bundled SITL in this process: its ports plugged in as `mem:` connection strings."""
+
+    def __init__(self, options: LockstepOptions) -> None:
+        module = importlib.import_module("sitl.lockstep")
+        try:
+            self.sitl = module.start(options.profile, options.world, options.vehicles,
+                                     options.seed, options.noise, options.signing_key)
+        except (ValueError, OSError) as exc:
+            where = f"--world {options.world}: " if isinstance(options.world, Path) else ""
+            raise UsageError(f"{where}{exc}") from None
+        self.clock = LockstepClock(self.sitl)
+        self._prefix = f"lockstep{next(_instances)}"
+        self._names: list[str] = []
+        self.vehicles = {s: self._plug(f"vehicle{s}", self.sitl.vehicle_port(s))
+                         for s in range(1, options.vehicles + 1)}
+        self.mocap = (self._plug("mocap", self.sitl.mocap_port())
+                      if self.sitl.mocap_enabled else None)
+        self.truth = self._plug("truth", self.sitl.truth_port()) if options.truth else None
+
+    def _plug(self, what: str, port: Any) -> str:
+        name = f"{self._prefix}/{what}"
+        self._names.append(name)
+        return memory.plug(name, port)
+
+    def url(self, sysid: int = 1) -> str:
+        """The vehicle's connection string."""
+        return self.vehicles[sysid]
+
+    def close(self) -> None:
+        """Unplug every port (the simulation itself is garbage once nobody holds it)."""
+        for name in self._names:
+            memory.unplug(name)
+        self._names.clear()
+
+
+class SteppedTruth:
+    """A vehicle's truth reports, collected on the station's tick instead of by a thread (as
+    `TruthRecorder` does over TCP): in lockstep a thread would read at wall-clock moments."""
+
+    def __init__(self, link: TruthLink, sysid: int) -> None:
+        self.link = link
+        self.sysid = sysid
+        self._reports: list[TruthReport] = []
+
+    def pump(self, *_: object) -> None:
+        """Take what arrived (a station listener: called after every tick)."""
+        self._reports.extend(r for r in self.link.poll() if r.sysid == self.sysid)
+
+    def reports(self) -> list[TruthReport]:
+        """Every report so far, oldest first."""
+        self.pump()
+        return list(self._reports)
+
+    def close(self) -> None:
+        """Close the link. Idempotent."""
+        self.link.close()

@@ -1,0 +1,76 @@
+"""`StationSession` in lockstep: the bundled SITL in this process, on the station's clock.
+
+Everything after the SITL's start is the session a pilot gets: a recorder per vehicle, the link
+opened and brought up, the throttle curve read, the pre-flight checks, motion capture and a
+`Station`. Only what differs is here: the SITL is `gcs.lockstep.BundledLockstep` instead of a
+subprocess, the clock is its `LockstepClock`, the truth reports are taken on the station's tick,
+and the stations are run by `run_tick()` (see `tick`) instead of loop threads.
+
+A campaign may hand over an already loaded world (its noise and floor varied) and a station
+configuration object instead of files; a pilot's `fly --lockstep` passes files as over TCP.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from firmware_link.truth_link import TruthLink
+from gcs.config import StationConfig, load_config
+from gcs.errors import UsageError
+from gcs.lockstep import BundledLockstep, LockstepOptions, SteppedTruth
+from gcs.session import SCORED_COMMANDS, SessionOptions, StationSession
+
+LOCKSTEP_EPOCH_NS = 946_684_800 * 10**9
+"""2000-01-01T00:00:00Z: where simulated time zero sits on a lockstep recording's timeline. A
+simulated flight has no date of its own, and a wall-clock anchor would make two recordings of one
+seed differ (the metadata's `started_utc` says when it was flown)."""
+
+
+class LockstepSession(StationSession):
+    """Context manager: the vehicles' stations on the bundled SITL's simulated clock."""
+
+    recording_anchor_ns = LOCKSTEP_EPOCH_NS
+
+    def __init__(self, options: SessionOptions, *, world: Any = None,
+                 config: StationConfig | None = None, noise: bool = True) -> None:
+        self._refuse(options)
+        self._world = world if world is not None else options.world
+        self._config = config
+        self._noise = noise
+        truth = options.command in SCORED_COMMANDS or options.metadata.get("truth") == "on"
+        self.sitl = BundledLockstep(LockstepOptions(
+            profile=options.profile, world=self._world, vehicles=max(options.sysids),
+            seed=options.seed or 0, noise=noise, truth=truth, signing_key=None))
+        super().__init__(options)
+        self._stack.callback(self.sitl.close)
+        self.clock = self.sitl.clock
+
+    @staticmethod
+    def _refuse(o: SessionOptions) -> None:
+        """Lockstep flies the bundled SITL only, over its (unthrottled) in-memory link."""
+        for flag, given in (("--connect", o.connect is not None), ("--mocap", o.mocap is not None),
+                            ("--serial", o.serial), ("--speedup", o.speedup != 1.0),
+                            ("--foxglove", o.foxglove is not None),
+                            ("--signing-key", o.signing_key is not None),
+                            ("--forward", bool(getattr(o, "forward", ())))):
+            if given:
+                raise UsageError(f"--lockstep: {flag} cannot be used with it (lockstep flies "
+                                 "the bundled SITL in this process on simulated time)")
+
+    def _open(self) -> None:
+        config = self._config if self._config is not None else load_config(self.options.config)
+        for sysid in self.options.sysids:
+            self.vehicles[sysid] = self._open_vehicle(sysid, self.sitl.url(sysid),
+                                                      self.sitl.mocap, None, config)
+        if self.sitl.truth is not None:
+            for sysid, v in self.vehicles.items():
+                truth = SteppedTruth(TruthLink.open(self.sitl.truth, clock=self.clock.now_s),
+                                     sysid)
+                self._stack.callback(truth.close)
+                v.station.add_listener(truth.pump)
+                v.truth = truth  # type: ignore[assignment]
+
+    def tick(self) -> None:
+        """One tick of every vehicle's station (the simulation runs up to each deadline)."""
+        for v in self.vehicles.values():
+            v.station.run_tick()

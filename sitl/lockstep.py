@@ -1,0 +1,201 @@
+"""Lockstep: the simulation on its caller's clock, behind in-memory byte ports.
+
+A station in the same process owns time. `advance_to(t_s)` runs every vehicle's 100 Hz tick up
+to `t_s` and moves what each tick sent into the ports, as the socket server flushes its
+endpoints after every tick; bytes a station writes reach the vehicle at once, at the current
+simulated time, as the server reads its sockets between ticks. Waiting for bytes
+(`MemoryPort.wait_readable`) is letting simulated time pass. Nothing here reads the wall clock,
+sleeps or starts a thread, so a flight runs as fast as the CPU allows and repeats bit for bit
+from its seed.
+
+What crosses a port is MAVLink, the frames the TCP endpoints send (`Channel`, `MocapEncoder`,
+`TruthEncoder`): the station decodes them with its own codec and learns nothing else about the
+simulation. A port behaves as the TCP endpoint does: unthrottled, and a reader that falls more
+than `PORT_BACKLOG_BYTES` behind loses what does not fit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from sitl.autopilot import AutopilotOptions, Profile
+from sitl.link.channel import Channel
+from sitl.mocap_server import MocapEncoder
+from sitl.simulation import Simulation
+from sitl.truth_server import TruthEncoder
+from sitl.world import World, default_world, load_world
+
+PORT_BACKLOG_BYTES = 65536  # as the TCP endpoint's backlog (sitl.link.endpoints)
+_EPS_S = 1e-9
+
+
+class PortClosed(OSError):
+    """The port was closed (by either side)."""
+
+
+class MemoryPort:
+    """One connection point: what the simulation sent waits here until read; what is written
+    goes to the simulation at once."""
+
+    def __init__(self, owner: LockstepSitl, name: str,
+                 receive: Callable[[bytes], None] | None) -> None:
+        self.owner = owner
+        self.name = name
+        self._receive = receive
+        self._rx = bytearray()
+        self.dropped_bytes = 0
+        self.closed = False
+
+    def deliver(self, data: bytes) -> None:
+        """Queue bytes for the reader (dropped when it is that far behind)."""
+        if not data or self.closed:
+            return
+        if len(self._rx) + len(data) > PORT_BACKLOG_BYTES:
+            self.dropped_bytes += len(data)
+            return
+        self._rx += data
+
+    @property
+    def readable(self) -> bool:
+        """Bytes are waiting."""
+        return bool(self._rx)
+
+    def read(self, max_bytes: int) -> bytes:
+        """Up to `max_bytes` of what waits; PortClosed once closed."""
+        if self.closed:
+            raise PortClosed(f"{self.name}: closed")
+        out = bytes(self._rx[:max_bytes])
+        del self._rx[:max_bytes]
+        return out
+
+    def write(self, data: bytes | memoryview) -> int:
+        """Hand `data` to the simulation (all of it); PortClosed once closed."""
+        if self.closed:
+            raise PortClosed(f"{self.name}: closed")
+        if self._receive is not None:
+            self._receive(bytes(data))
+        return len(data)
+
+    def wait_readable(self, timeout_s: float) -> None:
+        """Let simulated time pass until bytes wait or `timeout_s` has passed."""
+        self.owner.advance_until(lambda: bool(self._rx) or self.closed, timeout_s)
+
+    def close(self) -> None:
+        """Close the port (idempotent); the simulation stops feeding it."""
+        self.closed = True
+        self._rx.clear()
+
+
+class LockstepSitl:
+    """A `Simulation` advanced by its caller, with in-memory vehicle, mocap and truth ports."""
+
+    def __init__(self, world: World, profile: Profile = Profile.APM25, n_vehicles: int = 1,
+                 seed: int = 0, noise: bool = True, signing_key: bytes | None = None,
+                 options: AutopilotOptions | None = None) -> None:
+        self.sim = Simulation(world, profile, n_vehicles, seed=seed, noise=noise,
+                              signing_key=signing_key, options=options)
+        self._now_s = self.sim.t_s
+        self._vehicle_ports: list[tuple[Channel, MemoryPort]] = []
+        self._mocap_ports: list[MemoryPort] = []
+        self._truth_ports: list[MemoryPort] = []
+        mavlink1 = not profile.mavlink2
+        self._mocap = MocapEncoder(mavlink1)
+        self._truth = TruthEncoder(mavlink1)
+        self.ticks = 0
+
+    @property
+    def t_s(self) -> float:
+        """The shared clock: simulated seconds (at or after the last vehicle tick)."""
+        return self._now_s
+
+    @property
+    def mocap_enabled(self) -> bool:
+        """Whether the world has motion capture."""
+        return bool(self.sim.world.mocap_enabled)
+
+    # ------------------------------------------------------------------ ports
+    def vehicle_port(self, sysid: int = 1) -> MemoryPort:
+        """A new link to vehicle `sysid` (SR0_* stream rates, like the TCP endpoint)."""
+        rt = self.sim.vehicle(sysid)
+        ch = rt.add_channel(0, f"memory{len(rt.link.channels)}")
+        port = MemoryPort(self, f"vehicle{sysid}/{ch.name}",
+                          lambda data: rt.link.receive(ch, data))
+        self._vehicle_ports.append((ch, port))
+        return port
+
+    def mocap_port(self) -> MemoryPort:
+        """A new motion-capture client (ATT_POS_MOCAP of every vehicle); the world must have
+        motion capture on."""
+        if not self.mocap_enabled:
+            raise ValueError("the world has no motion capture")
+        port = MemoryPort(self, f"mocap{len(self._mocap_ports)}", None)
+        self._mocap_ports.append(port)
+        return port
+
+    def truth_port(self) -> MemoryPort:
+        """A new ground-truth client (LOCAL_POSITION_NED at 50 Hz, for scoring only)."""
+        port = MemoryPort(self, f"truth{len(self._truth_ports)}", None)
+        self._truth_ports.append(port)
+        return port
+
+    # ------------------------------------------------------------------ time
+    def advance_to(self, t_s: float) -> None:
+        """Run the vehicles' ticks up to `t_s`; the clock reads `t_s` after (never backwards)."""
+        sim = self.sim
+        while sim.t_s + sim.dt_s <= t_s + _EPS_S:
+            self._tick()
+        self._now_s = max(self._now_s, t_s)
+
+    def advance_until(self, done: Callable[[], bool], timeout_s: float) -> None:
+        """Tick until `done()` holds (checked before each tick) or `timeout_s` has passed."""
+        end = self._now_s + max(0.0, timeout_s)
+        sim = self.sim
+        while not done():
+            if sim.t_s + sim.dt_s > end + _EPS_S:
+                self._now_s = max(self._now_s, end)
+                return
+            self._tick()
+            self._now_s = max(self._now_s, sim.t_s)
+
+    def _tick(self) -> None:
+        sim = self.sim
+        sim.tick()
+        self.ticks += 1
+        for ch, port in self._vehicle_ports:
+            if port.closed:
+                ch.discard_output()
+            else:
+                port.deliver(ch.take())
+        frames = sim.take_mocap()
+        mocap = [p for p in self._mocap_ports if not p.closed]
+        if frames and mocap:
+            data = self._mocap.encode(frames)
+            for p in mocap:
+                p.deliver(data)
+        if self._truth.due(sim.t_s):
+            truth = [p for p in self._truth_ports if not p.closed]
+            if truth:
+                data = self._truth.encode(sim.t_s, sim.vehicles)
+                for p in truth:
+                    p.deliver(data)
+
+
+def start(profile: str = "apm25", world: str | Path | World | None = None, vehicles: int = 1,
+          seed: int = 0, noise: bool = True, signing_key: bytes | None = None) -> LockstepSitl:
+    """The bundled SITL as `python -m sitl` would start it, but in lockstep: the same world
+    file (or an already loaded `World`), profile, seed and the world's `[autopilot]` options.
+    A bad world file or profile is a ValueError of one line."""
+    try:
+        prof = Profile(profile)
+    except ValueError:
+        raise ValueError(f"profile {profile!r}: expected one of "
+                         f"{', '.join(p.value for p in Profile)}") from None
+    if isinstance(world, World):
+        loaded = world
+    else:
+        loaded = load_world(world) if world is not None else default_world()
+    if signing_key is not None and not prof.mavlink2:
+        raise ValueError("signing needs the copter4 profile (MAVLink 2)")
+    return LockstepSitl(loaded, prof, vehicles, seed=seed, noise=noise, signing_key=signing_key,
+                        options=loaded.autopilot)

@@ -1,0 +1,98 @@
+"""The SITL in lockstep: time passes only when its caller says, and what crosses a port is the
+MAVLink the TCP endpoints send."""
+
+from __future__ import annotations
+
+import pytest
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+from sitl.lockstep import PORT_BACKLOG_BYTES, PortClosed, start
+
+
+def _decode(data: bytes) -> list[mavlink.MAVLink_message]:
+    parser = mavlink.MAVLink(None)
+    return [m for m in parser.parse_buffer(data) or [] if m.get_type() != "BAD_DATA"]
+
+
+def test_time_moves_only_when_asked_and_never_back() -> None:
+    sitl = start(seed=1)
+    assert sitl.t_s == 0.0 and sitl.ticks == 0
+    sitl.advance_to(0.025)
+    # the 100 Hz ticks due by 25 ms ran; the clock reads the time asked, between ticks
+    assert sitl.ticks == 2 and sitl.t_s == pytest.approx(0.025)
+    sitl.advance_to(0.01)
+    assert sitl.t_s == pytest.approx(0.025) and sitl.ticks == 2
+
+
+def test_waiting_for_bytes_stops_at_the_tick_that_sent_them() -> None:
+    sitl = start(seed=1)
+    port = sitl.vehicle_port(1)
+    port.wait_readable(5.0)
+    # the autopilot's first heartbeat goes out on its first tick: not five seconds later
+    assert port.readable and sitl.t_s == pytest.approx(0.01)
+    kinds = {m.get_type() for m in _decode(port.read(PORT_BACKLOG_BYTES))}
+    assert "HEARTBEAT" in kinds
+    # nothing more until time passes; a wait with nothing to come runs out its time
+    assert not port.readable
+
+
+def test_a_request_written_is_answered_on_the_same_port() -> None:
+    sitl = start(seed=1)
+    port = sitl.vehicle_port(1)
+    gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+    req = mavlink.MAVLink_param_request_read_message(1, 1, b"SYSID_THISMAV", -1)
+    port.write(req.pack(gcs, force_mavlink1=True))
+    sitl.advance_to(0.05)
+    values = [m for m in _decode(port.read(PORT_BACKLOG_BYTES))
+              if m.get_type() == "PARAM_VALUE"]
+    assert [v.param_id for v in values] == ["SYSID_THISMAV"]
+    assert values[0].param_value == 1.0
+
+
+def test_truth_and_mocap_ports_stream_at_their_rates() -> None:
+    sitl = start(seed=1)
+    truth, mocap = sitl.truth_port(), sitl.mocap_port()
+    sitl.advance_to(1.0)
+    reports = [m for m in _decode(truth.read(PORT_BACKLOG_BYTES))
+               if m.get_type() == "LOCAL_POSITION_NED"]
+    poses = [m for m in _decode(mocap.read(PORT_BACKLOG_BYTES))
+             if m.get_type() == "ATT_POS_MOCAP"]
+    assert 49 <= len(reports) <= 51  # 50 Hz
+    assert 85 <= len(poses) <= 100  # 100 Hz, after the mocap system's latency
+    # standing on the floor: the centre of gravity a few cm up (NED: z negative)
+    assert -0.2 < reports[-1].z < 0.0
+
+
+def test_same_seed_same_bytes_other_seed_other_bytes() -> None:
+    def run(seed: int) -> bytes:
+        sitl = start(seed=seed)
+        port = sitl.vehicle_port(1)
+        gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+        port.write(mavlink.MAVLink_request_data_stream_message(1, 1, 0, 40, 1)
+                   .pack(gcs, force_mavlink1=True))
+        out = bytearray()
+        for k in range(1, 101):
+            sitl.advance_to(k * 0.01)
+            out += port.read(PORT_BACKLOG_BYTES)
+        return bytes(out)
+
+    first = run(7)
+    assert len(first) > 10_000
+    assert run(7) == first
+    assert run(8) != first
+
+
+def test_a_closed_port_refuses_and_is_no_longer_fed() -> None:
+    sitl = start(seed=1)
+    port = sitl.vehicle_port(1)
+    port.close()
+    sitl.advance_to(0.5)
+    with pytest.raises(PortClosed):
+        port.read(10)
+    with pytest.raises(PortClosed):
+        port.write(b"x")
+
+
+def test_bad_profile_is_one_line() -> None:
+    with pytest.raises(ValueError, match="profile 'apm26': expected one of apm25, copter4"):
+        start("apm26")
