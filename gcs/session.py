@@ -115,6 +115,9 @@ class Vehicle:
 class StationSession:
     """Context manager: the vehicles' stations, built but not started."""
 
+    # UTC nanoseconds at the clock's zero in recordings; None: the monotonic clock's zero
+    recording_anchor_ns: int | None = None
+
     def __init__(self, options: SessionOptions) -> None:
         options.validate()
         self.options = options
@@ -213,7 +216,8 @@ class StationSession:
             meta = {"command": o.command, "url": url, "vehicle": str(sysid),
                     "profile": o.profile, **{k: str(v) for k, v in o.metadata.items()}}
             try:
-                recorder = Recorder(o.output, metadata=meta, vehicle=f"vehicle{sysid}")
+                recorder = Recorder(o.output, metadata=meta, vehicle=f"vehicle{sysid}",
+                                    anchor_ns=self.recording_anchor_ns)
             except RecordingError as exc:
                 raise UsageError(f"-o {o.output}: {exc}") from None
             self._stack.callback(recorder.close)
