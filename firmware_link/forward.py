@@ -14,7 +14,10 @@ watching while a script flies, with one difference: only one writer of sticks at
   - anything while this station is silent (the link-loss policy): a forwarded station's
     heartbeat carries the same GCS id and would reset the very failsafe the silence is for;
   - unsigned or badly signed frames while the vehicle link signs: refused as this link refuses
-    them from the vehicle.
+    them from the vehicle;
+  - stream-rate requests (REQUEST_DATA_STREAM, SET_MESSAGE_INTERVAL): the firmware keeps one
+    set of rates per port, so MAVProxy's default 4 Hz request (or QGroundControl's) would starve
+    the 25 ms loop of the 40 Hz it set up; the other station gets every frame at that rate.
   Each refusal is counted and the first of each kind (and then one every `NOTE_EVERY_S`) is
   reported, so the pilot sees why the other station's sticks do nothing.
 - Several vehicles can share one forwarder (`port(sysid)` per link): a frame addressed to one
@@ -28,6 +31,7 @@ import threading
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from firmware_link.errors import LinkUsageError
 from firmware_link.forward_peers import (
@@ -50,10 +54,12 @@ class Refusal(enum.Enum):
     OVERRIDE = "RC override refused: quadgcs is writing the sticks"
     SILENT = "frame held back: quadgcs is silent so the vehicle's own failsafe can act"
     UNSIGNED = "unsigned or badly signed frame refused: the vehicle link signs"
+    STREAMS = "stream-rate request refused: quadgcs set the rates its loop needs"
 
 
 _COUNTER = {Refusal.OVERRIDE: "refused_overrides", Refusal.SILENT: "refused_silent",
-            Refusal.UNSIGNED: "refused_unsigned"}
+            Refusal.UNSIGNED: "refused_unsigned", Refusal.STREAMS: "refused_streams"}
+MAV_CMD_SET_MESSAGE_INTERVAL = 511
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,15 +74,36 @@ class ForwardStats:
     refused_overrides: int = 0
     refused_silent: int = 0
     refused_unsigned: int = 0
+    refused_streams: int = 0
     bad_frames: int = 0  # garbage and bad CRCs from stations
 
     @property
     def summary(self) -> str:
         """One line for a status bar or a log."""
-        refused = self.refused_overrides + self.refused_silent + self.refused_unsigned
+        refused = (self.refused_overrides + self.refused_silent + self.refused_unsigned
+                   + self.refused_streams)
         return (f"forward {', '.join(self.endpoints)}: {self.stations} station(s), "
                 f"{self.to_stations} out, {self.to_vehicle} in, "
                 f"{self.refused_overrides} override(s) refused, {refused} refused in all")
+
+
+class _Kind(enum.Enum):
+    """What the policy needs to know of a station's frame."""
+
+    OVERRIDE = "override"
+    STREAMS = "streams"
+    OTHER = "other"
+
+
+def _kind(msg: Any) -> _Kind:
+    kind = msg.get_type()
+    if kind == "RC_CHANNELS_OVERRIDE":
+        return _Kind.OVERRIDE
+    if kind == "REQUEST_DATA_STREAM" or (
+            kind in ("COMMAND_LONG", "COMMAND_INT")
+            and int(msg.command) == MAV_CMD_SET_MESSAGE_INTERVAL):
+        return _Kind.STREAMS
+    return _Kind.OTHER
 
 
 class Forwarder:
@@ -136,6 +163,7 @@ class Forwarder:
             refused_overrides=c("refused_overrides", 0),
             refused_silent=c("refused_silent", 0),
             refused_unsigned=c("refused_unsigned", 0),
+            refused_streams=c("refused_streams", 0),
             bad_frames=c("bad_frames", 0),
         )
 
@@ -176,7 +204,7 @@ class Forwarder:
             target = int(getattr(msg, "target_system", 0) or 0)
             for p in self._ports:
                 if p.sysid is None or target in (0, p.sysid):
-                    p.queue.append((msg.get_type(), bytes(msg.get_msgbuf())))
+                    p.queue.append((_kind(msg), bytes(msg.get_msgbuf())))
 
     def close(self) -> None:
         """Close every endpoint. Idempotent."""
@@ -194,7 +222,7 @@ class ForwardPort:
     def __init__(self, forwarder: Forwarder, sysid: int | None) -> None:
         self.forwarder = forwarder
         self.sysid = sysid
-        self.queue: deque[tuple[str, bytes]] = deque(maxlen=PORT_QUEUE_FRAMES)
+        self.queue: deque[tuple[_Kind, bytes]] = deque(maxlen=PORT_QUEUE_FRAMES)
         self._pending_notes: list[Refusal] = []
         self._last_note_s: dict[Refusal, float] = {}
 
@@ -220,7 +248,9 @@ class ForwardPort:
             kind, frame = self.queue.popleft()
             if silent:
                 self.refuse(Refusal.SILENT)
-            elif kind == "RC_CHANNELS_OVERRIDE" and sticks_owned:
+            elif kind is _Kind.STREAMS:
+                self.refuse(Refusal.STREAMS)
+            elif kind is _Kind.OVERRIDE and sticks_owned:
                 self.refuse(Refusal.OVERRIDE)
             else:
                 out.append(frame)

@@ -305,3 +305,24 @@ def test_several_vehicles_share_a_forwarder_by_target_system(forwarder: Forwarde
         assert decoded[1] == ["HEARTBEAT"]
     finally:
         station.close()
+
+
+def test_a_stations_stream_rate_requests_are_refused_and_its_commands_pass(
+        vehicle: FakeVehicle, forwarder: Forwarder) -> None:
+    link = VehicleLink.open(vehicle.url, forward=forwarder.port(None))
+    station = OtherStation.tcp(tcp_port(forwarder))
+    try:
+        run_until(link, lambda: forwarder.stats.stations == 1, station)
+        rates_before = dict(vehicle.state.rates_hz)
+        # MAVProxy's default: every stream at 4 Hz, which would starve a 40 Hz loop
+        station.send(station.mav.request_data_stream_encode(1, 1, 0, 4, 1))
+        station.send(station.mav.command_long_encode(1, 1, 511, 0, 30, 250000, 0, 0, 0, 0, 0))
+        station.send(station.mav.command_long_encode(1, 1, 512, 0, 148, 0, 0, 0, 0, 0, 0))
+        records = run_until(
+            link, lambda: any(m.get_type() == "AUTOPILOT_VERSION" for m in station.got), station)
+        assert forwarder.stats.refused_streams == 2
+        assert vehicle.state.rates_hz == rates_before
+        assert any("stream-rate request refused" in n for n in notes(records))
+    finally:
+        station.close()
+        link.close()
