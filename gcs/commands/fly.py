@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import ipaddress
 import json
 import math
@@ -152,6 +153,12 @@ def _print_summary(d: dict[str, Any]) -> None:
     print(f"link ({d['dialect']}): {d['rx_messages']} messages received, "
           f"{d['lost_messages']} lost, {d['corrupted_frames']} corrupted")
     print(f"learned hover throttle {d['hover_throttle']:.3f}")
+    if "forward" in d:
+        f = d["forward"]
+        print(f"forward {', '.join(f['endpoints'])}: {f['to_stations']} frames out, "
+              f"{f['to_vehicle']} in; refused: {f['refused_overrides']} RC overrides, "
+              f"{f['refused_streams']} stream-rate requests, {f['refused_silent']} while "
+              f"silent, {f['refused_unsigned']} unsigned")
     print(f"recording: {d['recording'] or 'off'}")
 
 
@@ -216,6 +223,9 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False) -
     d = _summary_dict(runner.summary(v.truth_series()), path, v.link.dialect)
     d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
     d["status"] = "ok"
+    forwarder = getattr(session, "forwarder", None)
+    if forwarder is not None:
+        d["forward"] = dataclasses.asdict(forwarder.stats)
     rms = d.get("rms_error_m")
     if not isinstance(rms, float) or not math.isfinite(rms) or rms > ABSURD_RMS_M:
         raise FlightFailed(f"hold error {rms} m is not a flight that went as commanded "
