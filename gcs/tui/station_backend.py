@@ -92,6 +92,8 @@ class StationBackend:
         est, att = snap.estimate, snap.attitude
         sonar = snap.rangefinder
         loop = snap.loop
+        forward = getattr(self.station.link, "forward", None)
+        fwd = forward.stats if forward is not None else None
         return TeleopView(
             t_s=snap.t_s,
             link=LinkView(
@@ -105,6 +107,8 @@ class StationBackend:
                 rx_bad=getattr(stats, "bad_frames", 0) + getattr(stats, "signature_refusals", 0),
                 signing=self.signing,
                 recording=self.recording,
+                fwd_stations=fwd.stations if fwd is not None else None,
+                fwd_refused_overrides=fwd.refused_overrides if fwd is not None else 0,
             ),
             vehicle=VehicleView(
                 mode=MODE_NAMES.get(snap.vehicle_mode, str(snap.vehicle_mode))

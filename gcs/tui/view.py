@@ -23,6 +23,9 @@ class LinkView:
     rx_bad: int = 0
     signing: bool = False
     recording: str | None = None
+    # forwarding: stations sharing the vehicle, and RC overrides of theirs refused
+    fwd_stations: int | None = None  # None: not forwarding
+    fwd_refused_overrides: int = 0
 
 
 @dataclass(frozen=True, slots=True)

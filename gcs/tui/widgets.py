@@ -54,6 +54,10 @@ class LinkPanel(Panel):
         text.append("  rec ")
         text.append(_flag(link.recording is not None, "on", "off"))
         text.append("\n")
+        if link.fwd_stations is not None:
+            text.append(f"fwd {link.fwd_stations} stn  ")
+            text.append(f"rc refused {link.fwd_refused_overrides}\n",
+                        style="yellow" if link.fwd_refused_overrides else "dim")
         text.append(f"loop {fmt(loop.period_ms, '.1f')} jit99 {fmt(loop.jitter_p99_ms, '.2f')}\n")
         text.append(f"cpu {fmt(loop.compute_ms, '.2f')} ms  ovr {loop.overruns}")
         return text
