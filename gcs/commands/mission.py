@@ -12,7 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from gcs.commands._vehicle_args import add_foxglove_argument
+from gcs.commands._vehicle_args import add_forward_argument, add_foxglove_argument
 from gcs.errors import MissionFailed, UsageError
 from gcs.mission.runner import RunOptions, run_mission
 from gcs.mission.spec import load_mission
@@ -44,6 +44,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--fix-failsafe", action="store_true",
                    help="let the station set the vehicles' GCS failsafe parameters when the "
                         "pre-flight checks find them unsafe; without it such a vehicle is refused")
+    add_forward_argument(r)
     add_foxglove_argument(r)
     r.add_argument("--json", action="store_true", help="print the result as one JSON object")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
@@ -61,15 +62,15 @@ def _progress(line: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """CLI entry: load, run, print; MissionFailed (exit 3) after printing when not reached."""
-    if args.kinematic and (args.connect or args.mocap):
-        raise UsageError("--kinematic flies no vehicle: drop --connect/--mocap")
+    if args.kinematic and (args.connect or args.mocap or args.forward):
+        raise UsageError("--kinematic flies no vehicle: drop --connect/--mocap/--forward")
     if args.speedup is not None and not 0 < args.speedup <= 50:
         raise UsageError(f"--speedup {args.speedup}: expected 0 < speedup <= 50")
     spec = load_mission(args.file)
     options = RunOptions(kinematic=args.kinematic, connect=args.connect, mocap=args.mocap,
                          record=args.record, output=args.output, plot=args.plot,
                          speedup=args.speedup, seed=args.seed, fix_failsafe=args.fix_failsafe,
-                         foxglove=args.foxglove)
+                         foxglove=args.foxglove, forward=tuple(args.forward))
     report = run_mission(spec, options, None if (args.quiet or args.json) else _progress)
     if args.json:
         print(report.to_json(), flush=True)

@@ -463,6 +463,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         world=spec.world_path, speedup=speedup, seed=options.seed, record=options.record,
         output=options.output, sysids=sysids, fix_failsafe=options.fix_failsafe,
         foxglove=getattr(options, "foxglove", None),
+        forward=options.forward,
         metadata={"mission": spec.name, "planner": spec.planner.value,
                   "mission_file": str(spec.path)})
     with StationSession(session_options) as session:

@@ -38,6 +38,7 @@ class RunOptions:
     seed: int | None = None
     fix_failsafe: bool = False  # the pilot's consent to set unsafe GCS-failsafe parameters
     foxglove: str | None = None  # [HOST:]PORT: serve the mission live to Foxglove
+    forward: tuple[str, ...] = ()  # other ground stations sharing the vehicles
 
 
 def mission_world(spec: MissionSpec) -> MissionWorld:
