@@ -5,7 +5,8 @@ Run: .venv/bin/python bench/planners.py [--rooms 30] [--seed 0]
 Prints, per thesis scene, each planner's outcome, path length and its ratio to A*'s, cost
 evaluations, node expansions, CPU per step, minimum clearance and collisions; checks the floors
 (0 collisions everywhere, EPBHA reaches every goal with >= 10x fewer cost evaluations than
-D* Lite and a path <= 1.5x A*'s); then a summary over seeded random cluttered rooms with a
+D* Lite and a path <= 1.5x A*'s); then a summary over seeded random cluttered rooms (each
+planner's minimum clearance and contacts with its body next to its success rate) with a
 breakdown of why EPBHA failed where it did. Exit status 1 when a thesis-scene floor fails.
 """
 
@@ -24,12 +25,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from planners.astar import plan_astar
 from planners.dstar_lite import run_dstar_lite
-from planners.epbha import run_epbha
+from planners.epbha_run import run_epbha
+from planners.kinematic import KinematicParams
 from planners.proximity import ProximityParams
 from planners.result import PlanResult
 from planners.scenes import Scene, random_room, thesis_scenes
 
 MAX_STEPS = 3000
+BODY_RADIUS_M = KinematicParams().body_radius_m
 PLANNERS: dict[str, Callable[[Scene], PlanResult]] = {
     "EPBHA": lambda s: run_epbha(s.world, s.start_n, s.goal_n, max_steps=MAX_STEPS),
     "A*": lambda s: plan_astar(s.world, s.start_n, s.goal_n),
@@ -136,26 +139,31 @@ def random_summary(rooms: int, seed: int) -> None:
     print(f"Random cluttered rooms: {rooms} rooms, seed {seed} (30 % of boxes reach the ceiling)")
     header = (
         f"{'planner':<9}{'success':>9}{'len/A*':>8}{'cost evals':>12}{'CPU/step ms':>12}"
-        f"{'rooms w/ coll':>14}{'penetrating':>12}"
+        f"{'min clr m':>10}{'contacts':>9}{'rooms w/ coll':>14}{'penetrating':>12}"
     )
     print(header)
     print("-" * len(header))
-    for name, results in per.items():
-        reached = sum(r.reached for r in results)
-        cpu = [r.cpu_mean_s_per_step for r in results if r.cpu_s_per_step]
-        grazed = sum(1 for r in results if r.collisions)
-        through = sum(1 for r in results if r.penetrations)
+    for name, runs in per.items():
+        reached = sum(r.reached for r in runs)
+        cpu = [r.cpu_mean_s_per_step for r in runs if r.cpu_s_per_step]
+        grazed = sum(1 for r in runs if r.collisions)
+        through = sum(1 for r in runs if r.penetrations)
+        contacts = sum(r.collisions for r in runs)
+        min_clr = min((r.min_clearance_m for r in runs), default=0.0)
         print(
-            f"{name:<9}{reached:>4}/{len(results):<4}"
+            f"{name:<9}{reached:>4}/{len(runs):<4}"
             f"{statistics.mean(ratios[name]) if ratios[name] else 0.0:>8.2f}"
-            f"{statistics.mean(r.cost_evaluations for r in results):>12.0f}"
-            f"{statistics.mean(cpu) * 1e3 if cpu else 0.0:>12.3f}{grazed:>14}{through:>12}"
+            f"{statistics.mean(r.cost_evaluations for r in runs):>12.0f}"
+            f"{statistics.mean(cpu) * 1e3 if cpu else 0.0:>12.3f}{min_clr:>10.3f}{contacts:>9}"
+            f"{grazed:>14}{through:>12}"
         )
+    print("(min clr: the closest any move of any room came to an obstacle or wall; contacts: "
+          f"moves within the {BODY_RADIUS_M} m body radius)")
     print(f"(goals A* proves unreachable on the grid: {unreachable}; A* plans in one step on the "
           "known map, its CPU includes building the grid)")
     if graze_m:
         print(f"EPBHA's closest approach in a grazing run: {min(graze_m):.3f} m "
-              "(body radius 0.15 m; six 45° cones leave blind wedges between them)")
+              f"(body radius {BODY_RADIUS_M} m; six 45° cones leave blind wedges between them)")
     print("EPBHA outcomes other than a clean arrival:")
     if not breakdown:
         print("  none")

@@ -2,7 +2,8 @@
 
 from planners.astar import astar_search, plan_astar
 from planners.dstar_lite import DStarLite, run_dstar_lite
-from planners.epbha import Decision, Epbha, EpbhaParams, ObstacleClass, run_epbha
+from planners.epbha import Decision, Epbha, EpbhaParams, ObstacleClass
+from planners.epbha_run import run_epbha
 from planners.flock_scenes import FlockScene
 from planners.flock_sim import FlockPlannerKind, FlockResult, run_flock
 from planners.flocking import FlockMission, FlockParams, FlockPlanner, FlockStep

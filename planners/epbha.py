@@ -53,178 +53,41 @@ Where this code departs from the text, and why:
   visits per grid cell and reports a deadlock (loop) instead of cycling; after a cave it climbs
   above the lid height it measured before moving on; and right after a keep-off step the side
   it backed away from counts as blocked once, so the obstacle is classified and avoided.
+- A free sensor is not a free path: six 45° cones see under a quarter of the sphere, and an
+  edge beside and below the vehicle (between two cones) is invisible when the vehicle is level
+  with it. After a one-cell side step around something seen ahead, the thesis's rule flew on
+  past that edge inside the body radius. A move is taken only when the swept body also clears
+  every return of the last few readings, each taken anywhere on its cone's cap unless a later
+  free cone rules that part out (:mod:`planners.return_memory`); a manoeuvre blocked only by
+  such a memory widens its berth sideways.
+
+`run_epbha` (:mod:`planners.epbha_run`) flies the planner in the kinematic world.
 """
 
 from __future__ import annotations
 
-import enum
 import math
-import time
 from collections import Counter
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import numpy as np
+from planners.epbha_manoeuvre import Manoeuvre
+from planners.epbha_types import (
+    AXIS_MOVES,
+    CostEntry,
+    Decision,
+    EpbhaParams,
+    Move,
+    ObstacleClass,
+    Plane,
+    Reason,
+    Status,
+)
+from planners.geometry import Vec3
+from planners.proximity import ProximityReading
+from planners.return_memory import ReturnMemory
 
-from planners.geometry import Vec3, World
-from planners.kinematic import KinematicParams, KinematicSim
-from planners.proximity import ProximityParams, ProximityReading
-from planners.result import PlanResult, PlanStatus
-
-
-class Move(enum.Enum):
-    """The six grid moves, as unit vectors in local NED."""
-
-    NORTH = (1, 0, 0)
-    SOUTH = (-1, 0, 0)
-    EAST = (0, 1, 0)
-    WEST = (0, -1, 0)
-    DOWN = (0, 0, 1)
-    UP = (0, 0, -1)
-
-    @property
-    def axis(self) -> int:
-        """Index of the NED axis the move is along."""
-        return next(i for i, c in enumerate(self.value) if c != 0)
-
-    @property
-    def sign(self) -> int:
-        """+1 or -1 along the move's axis."""
-        return self.value[self.axis]
-
-    @property
-    def opposite(self) -> Move:
-        """The move back."""
-        return _OPPOSITE[self]
-
-    def vec(self) -> Vec3:
-        """The unit vector as floats."""
-        return (float(self.value[0]), float(self.value[1]), float(self.value[2]))
-
-
-_OPPOSITE = {
-    Move.NORTH: Move.SOUTH,
-    Move.SOUTH: Move.NORTH,
-    Move.EAST: Move.WEST,
-    Move.WEST: Move.EAST,
-    Move.DOWN: Move.UP,
-    Move.UP: Move.DOWN,
-}
-_AXIS_MOVES = {0: (Move.NORTH, Move.SOUTH), 1: (Move.EAST, Move.WEST), 2: (Move.DOWN, Move.UP)}
-
-
-class Plane(enum.Enum):
-    """The plane searched: first the XY-plane goal, then the YZ-plane goal (Definition 1)."""
-
-    XY = (0, 1, 2)  # (axis weighted A, axis weighted B, out-of-plane axis)
-    YZ = (1, 2, 0)
-
-
-class Status(enum.Enum):
-    """What the planner tells the vehicle to do."""
-
-    MOVING = "moving"
-    REACHED = "reached"
-    DEADLOCK = "deadlock"
-
-
-class ObstacleClass(enum.Enum):
-    """Obstacle types EPBHA tells apart by its active sensors (§8.5, §9.3)."""
-
-    NONE = "none"
-    SINGLE_SIDED = "single-sided"
-    PARTITION = "partition"
-    CAVE = "cave"
-
-
-class Reason(enum.Enum):
-    """Why the planner chose this set position."""
-
-    COST = "minimum cost neighbour"
-    KEEP_OFF = "keep off a near obstacle"
-    GO_AROUND = "go around a single-sided obstacle"
-    PASS_ALONG = "pass alongside the obstacle"
-    PASS_OVER = "pass over a partition"
-    BACK_OFF = "back off diagonally from a cave"
-    REACHED = "goal reached"
-    DEADLOCK_BLOCKED = "deadlock: no free move"
-    DEADLOCK_LOOP = "deadlock: revisiting the same cells"
-
-
-@dataclass(frozen=True, slots=True)
-class EpbhaParams:
-    """EPBHA tuning; thesis values where the thesis gives one (sensors §8.6)."""
-
-    step_m: float = 0.1  # grid step d (the thesis leaves it to calibration)
-    weight_a: float = 4.0  # A of Definition 2, on the plane's first axis (x in XY, y in YZ)
-    weight_b: float = 2.0  # B of Definition 2, on the plane's second axis
-    sensor_range_m: float = 0.5  # §8.6
-    sensor_cone_deg: float = 45.0  # §8.6, full cone angle
-    keep_off_m: float = 0.25  # Subfunction 2's offset: the 0.15 m body plus 10 cm
-    body_radius_m: float = 0.17  # edge clearance wanted: the 0.15 m body plus 2 cm
-    max_visits: int = 4  # visits of one cell after which the planner reports a loop
-    max_alt_m: float = 2.0  # §8.1: the approximate maximum altitude indoors; never climb above
-
-    def __post_init__(self) -> None:
-        if not self.step_m > 0.0:
-            raise ValueError(f"EPBHA step_m must be > 0, got {self.step_m}")
-        if not (self.weight_a > 0.0 and self.weight_b > 0.0):
-            raise ValueError("EPBHA weights A and B must be > 0")
-        if not self.sensor_range_m > 0.0 or self.keep_off_m < 0.0:
-            raise ValueError("EPBHA sensor_range_m must be > 0 and keep_off_m >= 0")
-        if self.step_m + self.keep_off_m >= self.sensor_range_m:
-            raise ValueError(
-                f"EPBHA step_m + keep_off_m ({self.step_m + self.keep_off_m} m) must be below "
-                f"the sensor range ({self.sensor_range_m} m), or a blocked move is never seen"
-            )
-        if not self.max_alt_m > 0.0:
-            raise ValueError(f"EPBHA max_alt_m must be > 0, got {self.max_alt_m}")
-        if self.body_radius_m < 0.0 or self.max_visits < 1:
-            raise ValueError("EPBHA body_radius_m must be >= 0 and max_visits >= 1")
-
-    @property
-    def blocked_below_m(self) -> float:
-        """A move is blocked when its sensor sees something nearer than this."""
-        return self.step_m + self.keep_off_m
-
-
-@dataclass(frozen=True, slots=True)
-class CostEntry:
-    """One row of the cost table: a candidate neighbour and its cost (Definition 2)."""
-
-    move: Move
-    pos_n: Vec3
-    cost: float
-    free: bool
-
-
-@dataclass(frozen=True, slots=True)
-class Decision:
-    """One EPBHA step: the next set position and why."""
-
-    next_pos_n: Vec3
-    status: Status
-    reason: Reason
-    obstacle: ObstacleClass
-    plane: Plane
-    heading: Move | None
-    costs: tuple[CostEntry, ...]
-    cost_evaluations: int  # entries computed this step (0 during a manoeuvre)
-    movement_options: int  # sensors that see nothing (Subfunction 3)
-
-
-@dataclass(slots=True)
-class _Manoeuvre:
-    kind: ObstacleClass
-    heading: Move  # the blocked direction toward the goal
-    side: Move  # lateral side to go around or back off toward
-    over: Move  # the bypass direction (up in the XY plane)
-    stage: int = 0
-    clear_steps: int = 0
-    last_seen_m: float = 0.0  # the watched edge's distance when the cone last saw it
-    pass_along_m: float = 0.0  # distance still to go alongside before the obstacle is passed
-    back_next: bool = True
-    lid_z_m: float | None = None  # NED z of a cave's lid underside, when one was measured
+__all__ = ["CostEntry", "Decision", "Epbha", "EpbhaParams", "Move", "ObstacleClass", "Plane",
+           "Reason", "Status"]
 
 
 @dataclass
@@ -238,12 +101,13 @@ class Epbha:
     heading: Move | None = field(default=None, init=False)  # Subfunction 1, from the last move
     cost_evaluations: int = field(default=0, init=False)  # cost table entries so far
     _prev_n: Vec3 | None = field(default=None, init=False, repr=False)
-    _manoeuvre: _Manoeuvre | None = field(default=None, init=False, repr=False)
+    _manoeuvre: Manoeuvre | None = field(default=None, init=False, repr=False)
     _visits: Counter[tuple[int, int, int]] = field(
         default_factory=Counter, init=False, repr=False
     )
     _deadlocked: bool = field(default=False, init=False, repr=False)
     _recoiled_from: Move | None = field(default=None, init=False, repr=False)
+    _memory: ReturnMemory = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         for name in ("goal_n", "start_n"):
@@ -251,6 +115,8 @@ class Epbha:
             if len(v) != 3 or not all(math.isfinite(c) for c in v):
                 raise ValueError(f"EPBHA {name} must be 3 finite NED coordinates, got {v}")
             setattr(self, name, v)
+        self._memory = ReturnMemory(self.params.sensor_cone_deg, self.params.sensor_range_m,
+                                    horizon=self.params.memory_steps)
 
     # --- grid -------------------------------------------------------------------------
 
@@ -287,7 +153,7 @@ class Epbha:
     def grid_moves(self) -> tuple[Move, ...]:
         """Algorithm 3 (grid making): the four in-plane neighbour moves."""
         a, b, _ = self.plane.value
-        return (*_AXIS_MOVES[a], *_AXIS_MOVES[b])
+        return (*AXIS_MOVES[a], *AXIS_MOVES[b])
 
     @staticmethod
     def heading_of(prev_n: Vec3, pos_n: Vec3) -> Move | None:
@@ -296,7 +162,7 @@ class Epbha:
         axis = max(range(3), key=lambda i: abs(delta[i]))
         if abs(delta[axis]) < 1e-9:
             return None
-        plus, minus = _AXIS_MOVES[axis]
+        plus, minus = AXIS_MOVES[axis]
         return plus if delta[axis] > 0 else minus
 
     def movement_options(self, reading: ProximityReading) -> int:
@@ -307,7 +173,7 @@ class Epbha:
         """Subfunction 4: the sideways move (in plane, across `heading`) toward the goal's side."""
         a, b, _ = self.plane.value
         lateral_axis = b if heading.axis == a else a
-        plus, minus = _AXIS_MOVES[lateral_axis]
+        plus, minus = AXIS_MOVES[lateral_axis]
         offset = self.goal_n[lateral_axis] - pos_n[lateral_axis]
         if abs(offset) > self.params.step_m / 2.0:
             return plus if offset > 0 else minus
@@ -321,15 +187,35 @@ class Epbha:
         _, _, out = self.plane.value
         if out == 2:
             return Move.UP  # in the XY plane, passing over is climbing
-        plus, minus = _AXIS_MOVES[out]
+        plus, minus = AXIS_MOVES[out]
         sp, sm = reading.along_n(plus.vec()), reading.along_n(minus.vec())
         return minus if (sm is None and sp is not None) or (
             sm is not None and sp is not None and sm > sp
         ) else plus
 
-    def _free(self, reading: ProximityReading, move: Move) -> bool:
+    def _sensor_free(self, reading: ProximityReading, move: Move) -> bool:
+        """The move's own sensor sees nothing nearer than a step plus the keep-off distance."""
         seen = reading.along_n(move.vec())
         return seen is None or seen >= self.params.blocked_below_m
+
+    def _free(self, pos: Vec3, reading: ProximityReading, move: Move) -> bool:
+        """The move's sensor sees nothing near and the swept body clears every return seen."""
+        return self._sensor_free(reading, move) and self._clear_of_memory(
+            pos, self._neighbour(pos, move)
+        )
+
+    def _clear_of_memory(self, pos: Vec3, next_pos: Vec3) -> bool:
+        """No remembered return can lie within the body radius of the move's path.
+
+        A vehicle already nearer than that to a remembered return (the bound is conservative)
+        may still move clearly away from it, by at least half a step.
+        """
+        body = self.params.swept_clearance_m - 1e-9
+        if self._memory.segment_clearance(pos, next_pos) >= body:
+            return True
+        here = self._memory.segment_clearance(pos, pos)
+        there = self._memory.segment_clearance(next_pos, next_pos)
+        return there >= min(body, here + self.params.step_m / 2.0)
 
     def _active(self, reading: ProximityReading, move: Move) -> bool:
         seen = reading.along_n(move.vec())
@@ -346,7 +232,7 @@ class Epbha:
         """The bypass step is free and, when climbing, stays below the maximum altitude."""
         if over is Move.UP and -pos_n[2] + self.params.step_m > self.params.max_alt_m + 1e-9:
             return False
-        return self._free(reading, over)
+        return self._free(pos_n, reading, over)
 
     def classify(self, reading: ProximityReading, heading: Move, pos_n: Vec3) -> ObstacleClass:
         """The obstacle class seen at `pos_n` when `heading` is blocked (module docstring)."""
@@ -361,7 +247,7 @@ class Epbha:
         oblique_m = math.inf
         if front is not None:
             oblique_m = 0.9 * front / math.sin(math.radians(self.params.sensor_cone_deg) / 2.0)
-        for move in _AXIS_MOVES[lateral_axis]:
+        for move in AXIS_MOVES[lateral_axis]:
             seen = reading.along_n(move.vec())
             if seen is not None and seen <= self.params.sensor_range_m and seen < oblique_m:
                 return ObstacleClass.PARTITION
@@ -371,7 +257,9 @@ class Epbha:
 
     def step(self, pos_n: Vec3, reading: ProximityReading) -> Decision:
         """One planning step from the measured position and the six sensor readings."""
-        pos = self._snap(tuple(float(c) for c in pos_n))  # type: ignore[arg-type]
+        measured = (float(pos_n[0]), float(pos_n[1]), float(pos_n[2]))
+        self._memory.add(measured, reading)
+        pos = self._snap(measured)
         if self._prev_n is not None:
             self.heading = self.heading_of(self._prev_n, pos) or self.heading
         self._prev_n = pos
@@ -409,7 +297,7 @@ class Epbha:
         # oscillate, so that side counts as blocked once and the obstacle gets classified.
         recoiled, self._recoiled_from = self._recoiled_from, None
         table = tuple(
-            CostEntry(m, n, self.cost(n), self._free(reading, m) and m is not recoiled)
+            CostEntry(m, n, self.cost(n), self._free(pos, reading, m) and m is not recoiled)
             for m in self.grid_moves()
             for n in (self._neighbour(pos, m),)
         )
@@ -449,7 +337,9 @@ class Epbha:
         if away is Move.UP and -pos[2] + self.params.step_m > self.params.max_alt_m + 1e-9:
             return None
         far = reading.along_n(away.vec())
-        if far is None or far > nearest[0] + 2.0 * self.params.step_m + 1e-9:
+        if (far is None or far > nearest[0] + 2.0 * self.params.step_m + 1e-9) and (
+            self._clear_of_memory(pos, self._neighbour(pos, away))
+        ):
             return away
         return None
 
@@ -464,7 +354,7 @@ class Epbha:
         kind = self.classify(reading, heading, pos)
         side = self.lateral_toward_goal(pos, heading, reading)
         over = self._over_move(reading)
-        man = _Manoeuvre(kind, heading, side, over)
+        man = Manoeuvre(kind, heading, side, over)
         seen_ahead = reading.along_n(heading.vec())
         # Passing alongside must at least reach the face that blocked the way.
         man.pass_along_m = (seen_ahead or 0.0) + self.params.body_radius_m
@@ -472,7 +362,7 @@ class Epbha:
             seen_up = reading.along_n(over.vec())
             if over is Move.UP and seen_up is not None:
                 man.lid_z_m = pos[2] - seen_up
-            if not self._free(reading, side):
+            if not self._free(pos, reading, side):
                 man.side = side.opposite
         self._manoeuvre = man
         decision = self._continue_manoeuvre(pos, reading, options, table)
@@ -497,9 +387,13 @@ class Epbha:
 
         if man.kind is ObstacleClass.SINGLE_SIDED:
             if man.stage == 0:
-                man.clear_steps = self._watch(man, reading, man.heading)
-                if man.clear_steps <= self._margin_steps(man):
-                    if self._free(reading, man.side):
+                man.clear_steps = man.watch(reading, man.heading, self.params.sensor_range_m)
+                # The edge may have left the cone into a blind wedge: remembered returns
+                # keep the way ahead blocked until the body has cleared them.
+                if man.clear_steps <= man.margin_steps(self.params) or not self._free(
+                    pos, reading, man.heading
+                ):
+                    if self._free(pos, reading, man.side):
                         return go(man.side, Reason.GO_AROUND)
                     # The way around is closed too: it is a partition after all.
                     man.kind, man.stage, man.clear_steps = ObstacleClass.PARTITION, 0, 0
@@ -507,13 +401,19 @@ class Epbha:
                 man.stage, man.clear_steps = 1, 0
             if man.stage == 1:
                 beside = man.side.opposite
-                man.clear_steps = self._watch(man, reading, beside)
+                man.clear_steps = man.watch(reading, beside, self.params.sensor_range_m)
                 heading_improves = not self._aligned(pos, man.heading.axis)
                 short_of_face = man.pass_along_m > 1e-9
+                if heading_improves and not self._free(pos, reading, man.heading) and (
+                    self._sensor_free(reading, man.heading) and self._free(pos, reading, man.side)
+                ):
+                    # Only an earlier return, now in a blind wedge, is in the way: widen the
+                    # berth before going on.
+                    return go(man.side, Reason.GO_AROUND)
                 if (
-                    (short_of_face or man.clear_steps <= self._margin_steps(man))
+                    (short_of_face or man.clear_steps <= man.margin_steps(self.params))
                     and heading_improves
-                    and self._free(reading, man.heading)
+                    and self._free(pos, reading, man.heading)
                 ):
                     man.pass_along_m -= self.params.step_m
                     return go(man.heading, Reason.PASS_ALONG)
@@ -522,15 +422,15 @@ class Epbha:
 
         if man.kind is ObstacleClass.PARTITION:
             above_lid = man.lid_z_m is None or pos[2] < man.lid_z_m - self.params.keep_off_m
-            man.clear_steps = self._watch(man, reading, man.heading)
+            man.clear_steps = man.watch(reading, man.heading, self.params.sensor_range_m)
             if not above_lid:
                 man.clear_steps = 0
-            if man.clear_steps <= self._margin_steps(man):
+            if man.clear_steps <= man.margin_steps(self.params):
                 if self._can_bypass(pos, reading, man.over):
                     return go(man.over, Reason.PASS_OVER)
                 # Cannot pass over: go around on a free side, else it is a box to back out of.
                 for side in (man.side, man.side.opposite):
-                    if self._free(reading, side) and man.stage == 0:
+                    if self._free(pos, reading, side) and man.stage == 0:
                         man.kind, man.side, man.stage, man.clear_steps = (
                             ObstacleClass.SINGLE_SIDED, side, 0, 0)
                         return go(side, Reason.GO_AROUND)
@@ -548,39 +448,25 @@ class Epbha:
             # No lid but no room to climb either (walls up to the maximum altitude): back out
             # straight until a side opens, then go around on it.
             for side in (man.side, man.side.opposite):
-                if self._free(reading, side):
+                if self._free(pos, reading, side):
                     man.kind, man.side, man.stage, man.clear_steps = (
                         ObstacleClass.SINGLE_SIDED, side, 0, 0)
                     return go(side, Reason.GO_AROUND)
-            if self._free(reading, back):
+            if self._free(pos, reading, back):
                 return go(back, Reason.BACK_OFF)
             self._manoeuvre = None
             return self._hover(pos, Reason.DEADLOCK_BLOCKED, options, ObstacleClass.CAVE, table)
         order = (back, man.side) if man.back_next else (man.side, back)
         for move in order:
-            if self._free(reading, move):
+            if self._free(pos, reading, move):
                 man.back_next = move is not back
                 return go(move, Reason.BACK_OFF)
-        if self._free(reading, man.side.opposite):
+        if self._free(pos, reading, man.side.opposite):
             man.side = man.side.opposite
             man.back_next = True
             return go(man.side, Reason.BACK_OFF)
         self._manoeuvre = None
         return self._hover(pos, Reason.DEADLOCK_BLOCKED, options, ObstacleClass.CAVE, table)
-
-    def _watch(self, man: _Manoeuvre, reading: ProximityReading, move: Move) -> int:
-        """Steps since the sensor along `move` last saw the edge being cleared."""
-        seen = reading.along_n(move.vec())
-        if seen is not None and seen <= self.params.sensor_range_m:
-            man.last_seen_m = seen
-            return 0
-        return man.clear_steps + 1
-
-    def _margin_steps(self, man: _Manoeuvre) -> int:
-        """Extra steps after the edge left the cone until the body has cleared it."""
-        half = math.radians(self.params.sensor_cone_deg) / 2.0
-        short_m = self.params.body_radius_m - man.last_seen_m * math.tan(half)
-        return max(0, math.ceil(short_m / self.params.step_m - 1e-9))
 
     # --- decisions --------------------------------------------------------------------
 
@@ -607,51 +493,3 @@ class Epbha:
         return Decision(pos, Status.DEADLOCK, reason, obstacle, self.plane, self.heading, table,
                         0, options)
 
-
-def run_epbha(
-    world: World,
-    start_n: Vec3,
-    goal_n: Vec3,
-    params: EpbhaParams | None = None,
-    max_steps: int = 2000,
-    kinematic: KinematicParams | None = None,
-    proximity: ProximityParams | None = None,
-    rng: np.random.Generator | None = None,
-    cpu_clock: Callable[[], float] = time.process_time,
-) -> PlanResult:
-    """Fly EPBHA in the kinematic world from `start_n` toward `goal_n`."""
-    params = params or EpbhaParams()
-    if world.clearance(start_n) == 0.0:
-        return PlanResult("EPBHA", PlanStatus.START_BLOCKED, (tuple(start_n),), 0, 0, (), 0.0,
-                          0, "start is inside an obstacle or outside the room")
-    proximity = proximity or ProximityParams(range_m=params.sensor_range_m)
-    sim = KinematicSim(world, start_n, kinematic or KinematicParams(), proximity, rng)
-    planner = Epbha(params, goal_n, start_n)
-    cpu: list[float] = []
-    status, detail = PlanStatus.MAX_STEPS, f"no goal after {max_steps} steps"
-    for _ in range(max_steps + 1):
-        reading = sim.sense()
-        t0 = cpu_clock()
-        decision = planner.step(sim.pos_n, reading)
-        cpu.append(cpu_clock() - t0)
-        if decision.status is Status.REACHED:
-            status, detail = PlanStatus.REACHED, ""
-            break
-        if decision.status is Status.DEADLOCK:
-            status, detail = PlanStatus.DEADLOCK, decision.reason.value
-            break
-        if len(sim.path) > max_steps:
-            break
-        sim.move_to(decision.next_pos_n)
-    return PlanResult(
-        planner="EPBHA",
-        status=status,
-        path=tuple(sim.path),
-        cost_evaluations=planner.cost_evaluations,
-        node_expansions=0,
-        cpu_s_per_step=tuple(cpu),
-        min_clearance_m=sim.min_clearance_m if math.isfinite(sim.min_clearance_m) else 0.0,
-        collisions=sim.collisions,
-        detail=detail,
-        penetrations=sim.penetrations,
-    )

@@ -12,8 +12,8 @@ from planners.epbha import (
     Plane,
     Reason,
     Status,
-    run_epbha,
 )
+from planners.epbha_run import run_epbha
 from planners.proximity import Facing, ProximityReading
 from planners.result import PlanStatus
 from planners.scenes import Scene, thesis_scenes
@@ -144,8 +144,8 @@ def test_xy_goal_then_yz_goal_then_reached() -> None:
 def test_revisiting_a_cell_too_often_is_a_loop_deadlock() -> None:
     p = Epbha(EpbhaParams(max_visits=2), (2.0, 0.0, -1.0), START)
     for _ in range(2):
-        assert p.step(START, reading(up=0.1, down=0.1)).status is Status.MOVING
-    d = p.step(START, reading(up=0.1, down=0.1))
+        assert p.step(START, reading(up=0.2, down=0.2)).status is Status.MOVING
+    d = p.step(START, reading(up=0.2, down=0.2))
     assert d.status is Status.DEADLOCK and d.reason is Reason.DEADLOCK_LOOP
 
 

@@ -1,0 +1,163 @@
+"""EPBHA's vocabulary: moves, planes, statuses, obstacle classes, reasons, parameters, decisions.
+
+The planner itself is :mod:`planners.epbha`; these are the names its decisions are made of.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from planners.geometry import Vec3
+
+
+class Move(enum.Enum):
+    """The six grid moves, as unit vectors in local NED."""
+
+    NORTH = (1, 0, 0)
+    SOUTH = (-1, 0, 0)
+    EAST = (0, 1, 0)
+    WEST = (0, -1, 0)
+    DOWN = (0, 0, 1)
+    UP = (0, 0, -1)
+
+    @property
+    def axis(self) -> int:
+        """Index of the NED axis the move is along."""
+        return next(i for i, c in enumerate(self.value) if c != 0)
+
+    @property
+    def sign(self) -> int:
+        """+1 or -1 along the move's axis."""
+        return self.value[self.axis]
+
+    @property
+    def opposite(self) -> Move:
+        """The move back."""
+        return _OPPOSITE[self]
+
+    def vec(self) -> Vec3:
+        """The unit vector as floats."""
+        return (float(self.value[0]), float(self.value[1]), float(self.value[2]))
+
+
+_OPPOSITE = {
+    Move.NORTH: Move.SOUTH,
+    Move.SOUTH: Move.NORTH,
+    Move.EAST: Move.WEST,
+    Move.WEST: Move.EAST,
+    Move.DOWN: Move.UP,
+    Move.UP: Move.DOWN,
+}
+AXIS_MOVES = {0: (Move.NORTH, Move.SOUTH), 1: (Move.EAST, Move.WEST), 2: (Move.DOWN, Move.UP)}
+
+
+class Plane(enum.Enum):
+    """The plane searched: first the XY-plane goal, then the YZ-plane goal (Definition 1)."""
+
+    XY = (0, 1, 2)  # (axis weighted A, axis weighted B, out-of-plane axis)
+    YZ = (1, 2, 0)
+
+
+class Status(enum.Enum):
+    """What the planner tells the vehicle to do."""
+
+    MOVING = "moving"
+    REACHED = "reached"
+    DEADLOCK = "deadlock"
+
+
+class ObstacleClass(enum.Enum):
+    """Obstacle types EPBHA tells apart by its active sensors (§8.5, §9.3)."""
+
+    NONE = "none"
+    SINGLE_SIDED = "single-sided"
+    PARTITION = "partition"
+    CAVE = "cave"
+
+
+class Reason(enum.Enum):
+    """Why the planner chose this set position."""
+
+    COST = "minimum cost neighbour"
+    KEEP_OFF = "keep off a near obstacle"
+    GO_AROUND = "go around a single-sided obstacle"
+    PASS_ALONG = "pass alongside the obstacle"
+    PASS_OVER = "pass over a partition"
+    BACK_OFF = "back off diagonally from a cave"
+    REACHED = "goal reached"
+    DEADLOCK_BLOCKED = "deadlock: no free move"
+    DEADLOCK_LOOP = "deadlock: revisiting the same cells"
+
+
+@dataclass(frozen=True, slots=True)
+class EpbhaParams:
+    """EPBHA tuning; thesis values where the thesis gives one (sensors §8.6)."""
+
+    step_m: float = 0.1  # grid step d (the thesis leaves it to calibration)
+    weight_a: float = 4.0  # A of Definition 2, on the plane's first axis (x in XY, y in YZ)
+    weight_b: float = 2.0  # B of Definition 2, on the plane's second axis
+    sensor_range_m: float = 0.5  # §8.6
+    sensor_cone_deg: float = 45.0  # §8.6, full cone angle
+    keep_off_m: float = 0.25  # Subfunction 2's offset: the 0.15 m body plus 10 cm
+    body_radius_m: float = 0.17  # edge clearance wanted: the 0.15 m body plus 2 cm
+    # A move's path must keep this far from every return remembered: the 0.15 m body plus 2 cm.
+    # Not body_radius_m, which a mission may raise for position-hold error around edges seen.
+    swept_clearance_m: float = 0.17
+    # Returns are remembered for this many readings (0.3 m of travel): long enough to keep an
+    # edge that slipped into a blind wedge, short enough that a cap's rim, never resolved across
+    # the plane the vehicle moves in, does not shut passages it has already measured.
+    memory_steps: int = 3
+    max_visits: int = 4  # visits of one cell after which the planner reports a loop
+    max_alt_m: float = 2.0  # §8.1: the approximate maximum altitude indoors; never climb above
+
+    def __post_init__(self) -> None:
+        if not self.step_m > 0.0:
+            raise ValueError(f"EPBHA step_m must be > 0, got {self.step_m}")
+        if not (self.weight_a > 0.0 and self.weight_b > 0.0):
+            raise ValueError("EPBHA weights A and B must be > 0")
+        if not self.sensor_range_m > 0.0 or self.keep_off_m < 0.0:
+            raise ValueError("EPBHA sensor_range_m must be > 0 and keep_off_m >= 0")
+        if self.step_m + self.keep_off_m >= self.sensor_range_m:
+            raise ValueError(
+                f"EPBHA step_m + keep_off_m ({self.step_m + self.keep_off_m} m) must be below "
+                f"the sensor range ({self.sensor_range_m} m), or a blocked move is never seen"
+            )
+        if not self.max_alt_m > 0.0:
+            raise ValueError(f"EPBHA max_alt_m must be > 0, got {self.max_alt_m}")
+        if self.body_radius_m < 0.0 or self.max_visits < 1:
+            raise ValueError("EPBHA body_radius_m must be >= 0 and max_visits >= 1")
+        if self.swept_clearance_m < 0.0:
+            raise ValueError(f"EPBHA swept_clearance_m must be >= 0, got {self.swept_clearance_m}")
+        if self.memory_steps < 1:
+            raise ValueError(f"EPBHA memory_steps must be >= 1, got {self.memory_steps}")
+
+    @property
+    def blocked_below_m(self) -> float:
+        """A move is blocked when its sensor sees something nearer than this."""
+        return self.step_m + self.keep_off_m
+
+
+@dataclass(frozen=True, slots=True)
+class CostEntry:
+    """One row of the cost table: a candidate neighbour and its cost (Definition 2)."""
+
+    move: Move
+    pos_n: Vec3
+    cost: float
+    free: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """One EPBHA step: the next set position and why."""
+
+    next_pos_n: Vec3
+    status: Status
+    reason: Reason
+    obstacle: ObstacleClass
+    plane: Plane
+    heading: Move | None
+    costs: tuple[CostEntry, ...]
+    cost_evaluations: int  # entries computed this step (0 during a manoeuvre)
+    movement_options: int  # sensors that see nothing (Subfunction 3)
