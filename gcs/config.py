@@ -132,3 +132,9 @@ def load_config(path: str | Path | None) -> StationConfig:
     except tomllib.TOMLDecodeError as exc:
         raise UsageError(f"{p}: not valid TOML ({exc})") from None
     return _build(StationConfig(), data, f"{p}: ")
+
+
+def config_from_table(data: dict[str, Any], where: str = "") -> StationConfig:
+    """Defaults overridden by a station TOML's table as parsed (`where` prefixes an error's
+    key, e.g. the file it came from)."""
+    return _build(StationConfig(), data, where)

@@ -16,15 +16,17 @@ than `PORT_BACKLOG_BYTES` behind loses what does not fit.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
 from sitl.autopilot import AutopilotOptions, Profile
 from sitl.link.channel import Channel
 from sitl.mocap_server import MocapEncoder
+from sitl.params import ParamError
 from sitl.simulation import Simulation
 from sitl.truth_server import TruthEncoder
-from sitl.world import World, default_world, load_world
+from sitl.world import World, default_world, load_world, world_from_toml
 
 PORT_BACKLOG_BYTES = 65536  # as the TCP endpoint's backlog (sitl.link.endpoints)
 _EPS_S = 1e-9
@@ -181,20 +183,33 @@ class LockstepSitl:
                     p.deliver(data)
 
 
-def start(profile: str = "apm25", world: str | Path | World | None = None, vehicles: int = 1,
-          seed: int = 0, noise: bool = True, signing_key: bytes | None = None) -> LockstepSitl:
+def world_of(world: str | Path | Mapping[str, Any] | World | None) -> World:
+    """A world from a file, from a world file's table as parsed TOML (a campaign's varied
+    copy of one), or as given; None: the empty room. Problems are one-line ValueErrors."""
+    if isinstance(world, World):
+        return world
+    if world is None:
+        return default_world()
+    if isinstance(world, Mapping):
+        try:
+            return world_from_toml(dict(world))
+        except ParamError as exc:
+            raise ValueError(str(exc)) from None
+    return load_world(world)
+
+
+def start(profile: str = "apm25", world: str | Path | Mapping[str, Any] | World | None = None,
+          vehicles: int = 1, seed: int = 0, noise: bool = True,
+          signing_key: bytes | None = None) -> LockstepSitl:
     """The bundled SITL as `python -m sitl` would start it, but in lockstep: the same world
-    file (or an already loaded `World`), profile, seed and the world's `[autopilot]` options.
-    A bad world file or profile is a ValueError of one line."""
+    (see `world_of`), profile, seed and the world's `[autopilot]` options. A bad world or
+    profile is a ValueError of one line."""
     try:
         prof = Profile(profile)
     except ValueError:
         raise ValueError(f"profile {profile!r}: expected one of "
                          f"{', '.join(p.value for p in Profile)}") from None
-    if isinstance(world, World):
-        loaded = world
-    else:
-        loaded = load_world(world) if world is not None else default_world()
+    loaded = world_of(world)
     if signing_key is not None and not prof.mavlink2:
         raise ValueError("signing needs the copter4 profile (MAVLink 2)")
     return LockstepSitl(loaded, prof, vehicles, seed=seed, noise=noise, signing_key=signing_key,

@@ -31,6 +31,7 @@ EXAMPLES: dict[str, str] = {
     "params save": "quadgcs params save vehicle.parm",
     "params load": "quadgcs params load vehicle.parm",
     "params diff": "quadgcs params diff vehicle.parm",
+    "campaign": "quadgcs campaign campaigns/hold_seeds.toml --csv",
 }
 
 

@@ -200,14 +200,17 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
         return fly_session(session, plan, live=args.live)
 
 
-def fly_session(session: StationSession, plan: FlightPlan, live: bool = False) -> dict[str, Any]:
+def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
+                pilot_signals: bool = True) -> dict[str, Any]:
     """Fly `plan` on an open session's first vehicle (a lockstep session runs its ticks from
-    here); the summary dict, or FlightFailed."""
+    here); the summary dict, or FlightFailed. `pilot_signals`: the terminal's SIGTERM and
+    SIGQUIT land and kill this flight (a campaign's worker leaves its process's own)."""
     v = session.first
     lockstep = hasattr(session, "tick")
     with contextlib.suppress(ValueError):  # not the main thread (tests): no handlers
-        signal.signal(signal.SIGTERM, _on_sigterm)
-        signal.signal(signal.SIGQUIT, lambda _n, _f: v.station.kill())
+        if pilot_signals:
+            signal.signal(signal.SIGTERM, _on_sigterm)
+            signal.signal(signal.SIGQUIT, lambda _n, _f: v.station.kill())
     if not lockstep:
         v.station.start()
     printer = LivePrinter(session.clock) if live else None

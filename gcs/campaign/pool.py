@@ -1,0 +1,97 @@
+"""Running a campaign's runs as Ray tasks: an embedded local Ray by default, or a cluster.
+
+`--address HOST:PORT` (or `RAY_ADDRESS`) joins a running cluster without changing the file;
+every node needs quadgcs installed as here. An address nobody answers at is one line, found
+with a plain TCP connect first (Ray itself retries for minutes). The local Ray starts with the
+number of CPUs asked (all of this machine's by default) and no dashboard.
+
+Each run is one task of one CPU. A task that raised or whose worker died still gives a row
+(`failed`, with the reason), so the campaign goes on. Ctrl-C cancels what has not finished and
+returns the rows that had.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from typing import Any
+
+from gcs.campaign.metrics import failed_row
+from gcs.campaign.run import RunSpec
+from gcs.errors import RuntimeFault, UsageError
+
+ADDRESS_ENV = "RAY_ADDRESS"
+CONNECT_TIMEOUT_S = 3.0
+
+
+def _check_reachable(address: str) -> None:
+    """A TCP connect to HOST:PORT, so an unreachable cluster is one line, not minutes."""
+    if address == "auto" or "://" in address:
+        return
+    host, sep, port = address.rpartition(":")
+    if not sep or not port.isdigit():
+        raise UsageError(f"--address {address}: expected HOST:PORT of a Ray cluster's head "
+                         "(or auto, or ray://HOST:PORT)")
+    try:
+        with socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S):
+            pass
+    except OSError as exc:
+        raise RuntimeFault(f"--address {address}: no Ray cluster answers there "
+                           f"({exc.strerror or exc})") from None
+
+
+@contextmanager
+def ray_session(address: str | None, num_cpus: int | None) -> Iterator[Any]:
+    """Ray, started locally or joined at `address` (else RAY_ADDRESS); shut down after."""
+    import ray
+
+    address = address or os.environ.get(ADDRESS_ENV) or None
+    quiet: dict[str, Any] = {"log_to_driver": False, "logging_level": logging.ERROR}
+    if address is not None:
+        _check_reachable(address)
+        try:
+            ray.init(address=address, **quiet)
+        except (ConnectionError, RuntimeError, ValueError) as exc:
+            first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            raise RuntimeFault(f"--address {address}: cannot join the Ray cluster ({first})"
+                               ) from None
+    else:
+        ray.init(num_cpus=num_cpus, include_dashboard=False, **quiet)
+    try:
+        yield ray
+    finally:
+        ray.shutdown()
+
+
+def run_all(ray: Any, fn: Callable[..., dict[str, Any]], runs: Sequence[RunSpec],
+            args: tuple[Any, ...], on_row: Callable[[dict[str, Any]], None]) -> bool:
+    """Run `fn(*args[:1], run, *args[1:])` for every run as a task; `on_row` gets each row as
+    it finishes. False when interrupted (Ctrl-C), after cancelling the rest."""
+    task = ray.remote(num_cpus=1, max_retries=0)(fn)
+    pending: dict[Any, RunSpec] = {}
+    for run in runs:
+        pending[task.remote(args[0], run, *args[1:])] = run
+    try:
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1, timeout=1.0)
+            for ref in ready:
+                run = pending.pop(ref)
+                try:
+                    row = ray.get(ref)
+                except Exception as exc:  # the worker died or the task raised: still a row
+                    row = failed_row(run.run_id, run.values,
+                                     f"worker: {type(exc).__name__}: {_first_line(exc)}")
+                on_row(row)
+    except KeyboardInterrupt:
+        for ref in pending:
+            ray.cancel(ref, force=True)
+        return False
+    return True
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[-1] if text else ""
