@@ -34,6 +34,8 @@ class SwarmStep(Protocol):
     @property
     def messages_sent(self) -> int: ...
     @property
+    def state_reads(self) -> int: ...
+    @property
     def formation_samples(self) -> tuple[float, ...]: ...
 
 
@@ -125,11 +127,17 @@ class FlockResult:
     vehicle_collisions: int
     min_separation_m: float
     min_clearance_m: float
-    messages_sent: int
+    messages_sent: int  # eq. 9.1's leader positions (flock) or the all-to-all states (Reynolds)
+    state_reads: int  # the flock's reads of teammates' state beyond eq. 9.1 (guard, requests)
     formation_error_m: float | None
     gate_crossings_s: tuple[float, ...]
     paths_n: dict[int, np.ndarray]
     track_n: np.ndarray  # (steps + 1, n_vehicles, 3): every vehicle's position at every step
+
+    @property
+    def messages_total(self) -> int:
+        """Every message of the run, in the all-to-all baseline's unit (one per pair and step)."""
+        return self.messages_sent + self.state_reads
 
     @property
     def collisions(self) -> int:
@@ -222,6 +230,7 @@ def run_flock(
     }
     steps_to_goal: dict[int, int | None] = dict.fromkeys(ids)
     messages = 0
+    reads = 0
     err_sq = 0.0
     err_n = 0
     vv_collisions = 0
@@ -241,6 +250,7 @@ def run_flock(
         readings = {v: _sense_near(scene, sims[v], prm, rng) for v in ids}
         out = plan.step(step, positions, readings)
         messages += out.messages_sent
+        reads += out.state_reads
         for e in out.formation_samples:
             err_sq += e * e
             err_n += 1
@@ -296,6 +306,7 @@ def run_flock(
         min_separation_m=min_sep,
         min_clearance_m=min(s.min_clearance_m for s in sims.values()),
         messages_sent=messages,
+        state_reads=reads,
         formation_error_m=math.sqrt(err_sq / err_n) if err_n else None,
         gate_crossings_s=tuple(crossings),
         paths_n={v: np.array(sims[v].path) for v in ids},

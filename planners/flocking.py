@@ -27,6 +27,10 @@ A safety guard runs last for every vehicle, in tree order: a move is accepted on
 step moving straight to their granted set positions, the others standing still; otherwise the
 vehicle holds, which is always safe by the same rule. So the team never closes below the safe
 distance while vehicles fly straight to their set positions, whatever the planner above decides.
+The guard needs every teammate's position and planned set point, so it is all-to-all knowledge:
+each (reader, teammate) pair it reads in a step is booked as one message (``state_reads``),
+as are make-way requests and the flags a vehicle reads of its leader or the team, beside eq.
+9.1's positions (``messages_sent``).
 
 Departures from the text: the thesis's ``θ`` in "degree/100" and ``P(f1) = 1 − θ`` are not used
 (a probability from an angle in those units is not well defined); the sidestep rule classifies
@@ -200,7 +204,7 @@ class FlockStep:
     """Output of one planning step: set positions by vehicle id, and diagnostics."""
 
     setpoints_n: dict[int, Vec3]
-    messages_sent: int
+    messages_sent: int  # leader positions sent to followers (eq. 9.1)
     modes: dict[int, VehicleMode]
     roles: dict[int, Role]
     phase: Phase
@@ -208,6 +212,16 @@ class FlockStep:
     formation_samples: tuple[float, ...]
     leader_avoiding: bool
     held_by_guard: tuple[int, ...]
+    # Ordered (reader, owner) pairs of vehicles where the reader used the owner's state this
+    # step: the guard's positions and planned set points, make-way requests, a leader's queueing
+    # flag, the team's settled flags. Each pair is one message, the unit the all-to-all
+    # baseline is billed in (N·(N−1) per step); eq. 9.1's positions are counted apart.
+    state_reads: int = 0
+
+    @property
+    def messages_total(self) -> int:
+        """Every message of the step: eq. 9.1's positions plus the state reads."""
+        return self.messages_sent + self.state_reads
 
 
 @dataclass(slots=True)
@@ -268,6 +282,7 @@ class FlockPlanner:
         self._wait_at_common = 0
         self._states = [_State() for _ in range(self.n)]
         self._wanted: dict[int, Vec3] = {}  # guard-refused moves this step, by tree index
+        self._reads: set[tuple[int, int]] = set()  # (reader, owner) tree indexes, this step
         self._start_pos: list[Vec3] = []
         self._step_index = 0
         self._epbha: Epbha | None = None
@@ -322,6 +337,7 @@ class FlockPlanner:
             self._remember_returns(k, pos[k], rd[k])  # type: ignore[arg-type]
         reserved: list[Vec3] = list(pos)  # type: ignore[arg-type]
         self._wanted = {}
+        self._reads = set()
         self._start_pos = list(reserved)
         self._step_index = step_index
         modes: dict[int, VehicleMode] = {}
@@ -373,6 +389,7 @@ class FlockPlanner:
             formation_samples=tuple(samples),
             leader_avoiding=leader_avoiding,
             held_by_guard=tuple(held),
+            state_reads=len(self._reads),
         )
 
     # ----- building blocks ------------------------------------------------------------------
@@ -409,6 +426,7 @@ class FlockPlanner:
         for j, q1 in enumerate(reserved):
             if j == k:
                 continue
+            self._reads.add((k, j))  # j's position and, once planned, its set point
             q0 = self._start_pos[j]
             d0 = (p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2])
             dv = (
@@ -453,7 +471,9 @@ class FlockPlanner:
         """Vehicles of lower priority in the way of k's wanted move will step aside next step."""
         safe = self.params.formation.safe_distance_m
         for j in range(k + 1, self.n):
+            self._reads.add((k, j))
             if _dist(wanted, reserved[j]) < safe:
+                self._reads.add((j, k))  # the request itself
                 self._states[j].make_way_from.append(wanted)
 
     def _make_way(
@@ -525,6 +545,7 @@ class FlockPlanner:
             q = _add(p, d, s)
             if not self._guard_ok(k, q, reserved):
                 continue
+            self._reads.update((k, j) for j in range(self.n) if j != k)
             gap = min(_dist(q, r) for j, r in enumerate(reserved) if j != k)
             if gap > best_gap:
                 best, best_gap = q, gap
@@ -644,6 +665,7 @@ class FlockPlanner:
             return p, VehicleMode.WAITING
         par = self.formation.parent(k)
         assert par is not None
+        self._reads.add((k, par))
         leader_queues = self._states[par].in_trail
         if (
             not st.in_trail
@@ -685,6 +707,7 @@ class FlockPlanner:
         prm = self.params
         seen = reading.active(prm.formation.sensing_range_m)
         st.clear_steps = 0 if seen else st.clear_steps + 1
+        self._reads.add((k, self.formation.parent(k) or 0))
         if (
             st.clear_steps >= prm.rejoin_clear_steps
             and st.goal_n is not None
@@ -749,10 +772,13 @@ class FlockPlanner:
             assert par is not None
             # A slot is final only once its leader has settled in its own final slot; before
             # that it may still lie on the near side of a wall the leader has yet to pass.
+            if par != 0:
+                self._reads.add((k, par))
             leader_final = par == 0 or self._states[par].individual
             if not st.individual and leader_final and self._settled(k, pos[k]):
                 st.individual = True
                 st.avoid_dir = None
+        self._reads.update((0, k) for k in range(1, self.n))
         team_settled = all(self._states[k].individual for k in range(1, self.n))
         if not root.individual and (
             team_settled or self._wait_at_common >= self.params.common_wait_steps

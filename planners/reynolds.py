@@ -50,6 +50,7 @@ class ReynoldsStep:
     setpoints_n: dict[int, Vec3]
     messages_sent: int
     formation_samples: tuple[float, ...] = ()
+    state_reads: int = 0  # every teammate's state already arrives in the N·(N−1) messages
 
 
 class ReynoldsPlanner:

@@ -263,12 +263,14 @@ def _flock(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3]) -> _Outcome:
     pos = dict(hover)
     paths = {v: [p] for v, p in hover.items()}
     messages = 0
+    reads = 0
     err_sq, err_n = 0.0, 0
     time_to_goal: dict[int, float | None] = dict.fromkeys(ids)
     for k in range(setup.max_steps):
         readings = {v: f.crafts[v].reading() for v in ids}
         out = planner.step(k, pos, readings)
         messages += out.messages_sent
+        reads += out.state_reads
         for e in out.formation_samples:
             err_sq += e * e
             err_n += 1
@@ -286,8 +288,8 @@ def _flock(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3]) -> _Outcome:
                   f"{f.min_separation_m:.2f} m")
         if all(arrived.values()):
             return _Outcome(MissionStatus.REACHED, "every vehicle reached its goal", k,
-                            paths[ids[0]], _flock_metrics(f, messages, err_sq, err_n,
-                                                          time_to_goal, paths))
+                            paths[ids[0]], _flock_metrics(f, (messages, reads), err_sq,
+                                                          err_n, time_to_goal, paths))
         if f.over_budget():
             break
         pos = f.go(dict(out.setpoints_n))
@@ -296,20 +298,22 @@ def _flock(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3]) -> _Outcome:
     short = [v for v, t in time_to_goal.items() if t is None]
     return _Outcome(MissionStatus.FAILED, f"vehicles {short} short of their goals",
                     setup.max_steps, paths[ids[0]],
-                    _flock_metrics(f, messages, err_sq, err_n, time_to_goal, paths))
+                    _flock_metrics(f, (messages, reads), err_sq, err_n, time_to_goal, paths))
 
 
 def _length(path: list[Vec3]) -> float:
     return sum(math.dist(a, b) for a, b in itertools.pairwise(path))
 
 
-def _flock_metrics(f: _Flight, messages: int, err_sq: float, err_n: int,
+def _flock_metrics(f: _Flight, messages: tuple[int, int], err_sq: float, err_n: int,
                    time_to_goal: dict[int, float | None], paths: dict[int, list[Vec3]]
                    ) -> dict[str, Any]:
     return {
         "vehicles": len(paths),
         "min_separation_m": f.min_separation_m,
-        "messages_sent": messages,
+        "messages_sent": messages[0],  # eq. 9.1's leader positions
+        "state_reads": messages[1],  # the guard's and the coordination's reads of teammates
+        "messages_total": sum(messages),
         "formation_error_m": math.sqrt(err_sq / err_n) if err_n else None,
         "time_to_goal_s": {str(v): t for v, t in time_to_goal.items()},
         "path_length_per_vehicle_m": {str(v): _length(p) for v, p in paths.items()},

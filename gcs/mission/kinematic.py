@@ -208,6 +208,8 @@ def run_flock_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
             "min_separation_m": res.min_separation_m,
             "min_clearance_m": res.min_clearance_m,
             "messages_sent": res.messages_sent,
+            "state_reads": res.state_reads,
+            "messages_total": res.messages_total,
             "formation_error_m": res.formation_error_m,
             "time_to_goal_s": {str(v): res.time_to_goal_s(v) for v in res.steps_to_goal},
             "path_length_per_vehicle_m": {str(v): x for v, x in lengths.items()},

@@ -159,6 +159,7 @@ def flock_payload(step: int, positions_n: dict[int, Any], readings: dict[int, Pr
         "step": step,
         "phase": out.phase.value,
         "messages_sent": out.messages_sent,
+        "state_reads": out.state_reads,
         "formation_error_m": out.formation_error_m,
         "leader_avoiding": out.leader_avoiding,
         "held_by_guard": list(out.held_by_guard),

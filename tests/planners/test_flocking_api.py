@@ -72,3 +72,37 @@ def test_table_room_leader_ends_under_the_table() -> None:
     assert top.min_n[0] < end[0] < top.max_n[0] and top.min_n[1] < end[1] < top.max_n[1]
     assert end[2] > top.max_n[2]  # below the top (z is down)
     assert r.messages_sent > 0 and r.formation_error_m is not None
+
+
+def test_the_guard_reads_of_teammates_are_counted_once_per_pair_and_step() -> None:
+    ids = [11, 12, 13, 14, 15]
+    planner = FlockPlanner(ids, FlockMission((10.0, 0.0, -1.0)), (1.0, 0.0))
+    pos = planner.start_positions_n((2.0, 0.0, -1.0))
+    out = planner.step(0, pos, dict.fromkeys(ids, ProximityReading.clear()))
+    # Everyone moves on step 0, and each move's guard read all 4 teammates (position and
+    # planned set point): N (N - 1) = 20 pairs, however many candidate moves were tried.
+    assert all(out.setpoints_n[v] != pos[v] for v in ids)
+    assert out.state_reads == 20 and out.messages_total == 4 + 20
+
+
+def test_a_team_holding_its_slots_reads_only_the_settled_flags() -> None:
+    ids = [11, 12, 13, 14, 15]
+    planner = FlockPlanner(ids, FlockMission((2.0, 0.0, -1.0)), (1.0, 0.0))
+    pos = planner.start_positions_n((2.0, 0.0, -1.0))
+    clear = dict.fromkeys(ids, ProximityReading.clear())
+    out = planner.step(0, pos, clear)
+    assert out.setpoints_n == pos  # at the goal already: nobody moves, the guard reads nothing
+    assert out.state_reads == 4  # each follower looks whether its leader queues on a trail
+    out = planner.step(1, pos, clear)
+    # The root, at the common goal, asks each of 4 followers whether it settled; 14 and 15
+    # ask whether their leader 12 has.
+    assert out.setpoints_n == pos and out.state_reads == 4 + 2
+
+
+def test_run_books_every_message_of_the_flock() -> None:
+    r = run_flock(open_hall(), 5, FlockPlannerKind.TRIANGULAR, 80, np.random.default_rng(0))
+    assert r.state_reads > r.messages_sent > 0
+    assert r.messages_total == r.messages_sent + r.state_reads
+    assert r.messages_total <= r.steps * (5 * 4 + 4)  # all pairs plus eq. 9.1's 4 per step
+    rey = run_flock(open_hall(), 5, FlockPlannerKind.REYNOLDS, 80, np.random.default_rng(0))
+    assert rey.state_reads == 0 and rey.messages_total == rey.steps * 5 * 4
