@@ -1,7 +1,8 @@
 """Missions: files, the executor that connects planners to vehicles, and their metrics."""
 
+from gcs.mission.options import RunOptions
 from gcs.mission.report import MissionReport, MissionStatus, RunMode
-from gcs.mission.runner import RunOptions, run_mission
+from gcs.mission.runner import run_mission
 from gcs.mission.spec import MissionSpec, PlannerKind, load_mission
 from gcs.mission.world import MissionWorld, load_world
 

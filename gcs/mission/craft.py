@@ -9,6 +9,7 @@ reads snapshots, without loop statistics and not too often: every look takes the
 
 from __future__ import annotations
 
+import enum
 import math
 import threading
 import time
@@ -30,13 +31,22 @@ ALT_RATE_MPS = 0.4  # altitude set positions move at this rate (a jump upsets th
 POLL_S = 0.1
 
 
+class CraftPhase(enum.Enum):
+    """Where a vehicle is in the mission, for the truth samples and the collision books."""
+
+    GROUND = "ground"
+    TAKEOFF = "takeoff"
+    MISSION = "mission"
+    LAND = "land"
+
+
 @dataclass(frozen=True, slots=True)
 class TruthSample:
     """Ground truth at one time (SITL frame, NED from its first report)."""
 
     t_s: float
     pos_n: Vec3
-    phase: str
+    phase: CraftPhase
 
 
 @dataclass(slots=True)
@@ -60,7 +70,7 @@ class Craft:
     def __init__(self, sysid: int, station: Station) -> None:
         self.sysid = sysid
         self.station = station
-        self.phase = "ground"
+        self.phase = CraftPhase.GROUND
         self._lock = threading.Lock()
         self._b = _Books()
         self._target_n: Vec3 | None = None
@@ -80,7 +90,7 @@ class Craft:
                 b.last_mocap = r.pos_n
             elif isinstance(r, SimTruth) and all(math.isfinite(c) for c in r.pos_n):
                 b.truth.append(TruthSample(r.t_s, r.pos_n, self.phase))
-                if b.last_mocap is not None and self.phase == "ground":
+                if b.last_mocap is not None and self.phase is CraftPhase.GROUND:
                     b.mocap_at_truth.append((b.last_mocap, r.pos_n))
 
     # -------------------------------------------------------------- any thread

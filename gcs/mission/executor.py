@@ -28,8 +28,10 @@ import numpy as np
 from firmware_link.records import Battery, FlightMode, StatusText
 from gcs.errors import RuntimeFault
 from gcs.flight import FlightPlan, FlightRunner
-from gcs.mission.craft import Craft, go_to_all
+from gcs.mission.craft import Craft, CraftPhase, go_to_all
+from gcs.mission.options import RunOptions
 from gcs.mission.planner_params import PlannerSetup
+from gcs.mission.plot import write_radiation_plot
 from gcs.mission.radiation_maps import finish_radiation, is_reached
 from gcs.mission.recording import (
     SAMPLE_RADIATION,
@@ -124,7 +126,7 @@ class _Flight:
         for v, c in self.crafts.items():
             here = c.position_n()
             hover[v] = (here[0], here[1], -alt)
-            c.phase = "takeoff"
+            c.phase = CraftPhase.TAKEOFF
             c.station.alt_hold(True, alt, rate_mps=0.4)
         self.say(f"taking off to {alt:.2f} m")
         deadline = self.clock.now_s() + alt / 0.4 + 20.0
@@ -147,13 +149,13 @@ class _Flight:
         if late:
             raise RuntimeFault(f"take-off: vehicles {late} did not settle at {alt:.2f} m")
         for c in self.crafts.values():
-            c.phase = "mission"
+            c.phase = CraftPhase.MISSION
         return hover
 
     def land(self) -> None:
         """Land every vehicle, one after the other, where it is (see `_land_one`)."""
         for v, c in self.crafts.items():
-            c.phase = "land"
+            c.phase = CraftPhase.LAND
             self.say(f"vehicle {v}: landing")
             self._land_one(c)
 
@@ -456,7 +458,7 @@ def _radiation(f: _Flight, setup: PlannerSetup, hover: dict[int, Vec3],
                     metrics, (field_, products))
 
 
-def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, options: Any,
+def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, options: RunOptions,
                     progress: Progress | None) -> MissionReport:
     """Fly the mission with one station per vehicle; the report (with truth-based collisions)."""
     wall0 = time.monotonic()
@@ -466,7 +468,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         command="mission", connect=options.connect, mocap=options.mocap, profile=spec.profile,
         world=spec.world_path, speedup=speedup, seed=options.seed, record=options.record,
         output=options.output, sysids=sysids, fix_failsafe=options.fix_failsafe,
-        foxglove=getattr(options, "foxglove", None),
+        foxglove=options.foxglove,
         forward=options.forward,
         metadata={"mission": spec.name, "planner": spec.planner.value,
                   "mission_file": str(spec.path)})
@@ -512,8 +514,6 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         rec.put(SUMMARY, time.monotonic(), report.to_dict())
     if spec.planner is PlannerKind.RADIATION and outcome.products is not None \
             and outcome.products[1] is not None:
-        from gcs.mission.runner import write_radiation_plot
-
         report.metrics["plot"] = write_radiation_plot(spec, options, report, outcome.products)
     return report
 
@@ -526,7 +526,7 @@ def _truth_books(crafts: dict[int, Craft], mw: MissionWorld) -> tuple[int, dict[
     samples = 0
     for v, c in crafts.items():
         offset = c.truth_offset_n()
-        track = [s for s in c.truth() if s.phase in ("takeoff", "mission")]
+        track = [s for s in c.truth() if s.phase in (CraftPhase.TAKEOFF, CraftPhase.MISSION)]
         if offset is None or not track:
             continue
         books = check_contacts(

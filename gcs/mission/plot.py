@@ -1,4 +1,4 @@
-"""The radiation mission's picture (matplotlib, off-screen)."""
+"""The radiation mission's picture (matplotlib, off-screen) and where it is written."""
 
 from __future__ import annotations
 
@@ -8,6 +8,10 @@ from typing import Any
 
 import numpy as np
 
+from gcs.errors import UsageError
+from gcs.mission.options import RunOptions
+from gcs.mission.report import MissionReport
+from gcs.mission.spec import MissionSpec
 from planners.radiation_field import RadiationField
 
 
@@ -59,3 +63,25 @@ def radiation_figure(path: Path, field: RadiationField, products: dict[str, Any]
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def plot_path(spec: MissionSpec, options: RunOptions, recording: str | None) -> Path:
+    """`--plot PATH`, else next to the recording, else in the output directory."""
+    if options.plot is not None:
+        return options.plot
+    if recording is not None:
+        return Path(recording).with_suffix(".png")
+    out = options.output if options.output.suffix != ".mcap" else options.output.parent
+    return out / f"{spec.name}.png"
+
+
+def write_radiation_plot(spec: MissionSpec, options: RunOptions, report: MissionReport,
+                         products: Any) -> str:
+    """The picture: true field, samples, path, found contour vs reference contour."""
+    field, prod = products
+    path = plot_path(spec, options, report.recording)
+    try:
+        radiation_figure(path, field, prod, title=f"{spec.name} ({report.mode.value})")
+    except OSError as exc:
+        raise UsageError(f"--plot {path}: cannot write ({exc.strerror or exc})") from None
+    return str(path)

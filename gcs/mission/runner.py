@@ -7,38 +7,22 @@ import dataclasses
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from gcs.errors import UsageError
+from gcs.mission.executor import run_on_vehicles
 from gcs.mission.kinematic import (
     run_epbha_kinematic,
     run_flock_kinematic,
     run_radiation_kinematic,
 )
+from gcs.mission.options import RunOptions
 from gcs.mission.planner_params import planner_setup
+from gcs.mission.plot import write_radiation_plot
 from gcs.mission.recording import SUMMARY, MissionRecording
 from gcs.mission.report import MissionReport
 from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.world import MissionWorld, load_world
-
-
-@dataclass(frozen=True, slots=True)
-class RunOptions:
-    """How to run a mission (the CLI's flags)."""
-
-    kinematic: bool = False
-    connect: str | None = None
-    mocap: str | None = None
-    record: bool = True
-    output: Path = Path("flights")
-    plot: Path | None = None
-    speedup: float | None = None  # None: the mission file's
-    seed: int | None = None
-    fix_failsafe: bool = False  # the pilot's consent to set unsafe GCS-failsafe parameters
-    foxglove: str | None = None  # [HOST:]PORT: serve the mission live to Foxglove
-    forward: tuple[str, ...] = ()  # other ground stations sharing the vehicles
 
 
 def mission_world(spec: MissionSpec) -> MissionWorld:
@@ -67,8 +51,6 @@ def run_mission(spec: MissionSpec, options: RunOptions,
     if options.seed is not None:
         setup = dataclasses.replace(setup, seed=options.seed)
     if not options.kinematic:
-        from gcs.mission.executor import run_on_vehicles
-
         return run_on_vehicles(spec, mw, setup, options, progress)
     with contextlib.ExitStack() as stack:
         live = None
@@ -95,27 +77,3 @@ def run_mission(spec: MissionSpec, options: RunOptions,
     if spec.planner is PlannerKind.RADIATION and products is not None:
         report.metrics["plot"] = write_radiation_plot(spec, options, report, products)
     return report
-
-
-def plot_path(spec: MissionSpec, options: RunOptions, recording: str | None) -> Path:
-    """`--plot PATH`, else next to the recording, else in the output directory."""
-    if options.plot is not None:
-        return options.plot
-    if recording is not None:
-        return Path(recording).with_suffix(".png")
-    out = options.output if options.output.suffix != ".mcap" else options.output.parent
-    return out / f"{spec.name}.png"
-
-
-def write_radiation_plot(spec: MissionSpec, options: RunOptions, report: MissionReport,
-                         products: Any) -> str:
-    """The picture: true field, samples, path, found contour vs reference contour."""
-    from gcs.mission.plot import radiation_figure
-
-    field, prod = products
-    path = plot_path(spec, options, report.recording)
-    try:
-        radiation_figure(path, field, prod, title=f"{spec.name} ({report.mode.value})")
-    except OSError as exc:
-        raise UsageError(f"--plot {path}: cannot write ({exc.strerror or exc})") from None
-    return str(path)

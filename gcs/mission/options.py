@@ -1,0 +1,23 @@
+"""How a mission is run: the command line's choices, handed to the runner and the executor."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True, slots=True)
+class RunOptions:
+    """How to run a mission (the CLI's flags)."""
+
+    kinematic: bool = False
+    connect: str | None = None
+    mocap: str | None = None
+    record: bool = True
+    output: Path = Path("flights")
+    plot: Path | None = None
+    speedup: float | None = None  # None: the mission file's
+    seed: int | None = None
+    fix_failsafe: bool = False  # the pilot's consent to set unsafe GCS-failsafe parameters
+    foxglove: str | None = None  # [HOST:]PORT: serve the mission live to Foxglove
+    forward: tuple[str, ...] = ()  # other ground stations sharing the vehicles
