@@ -23,6 +23,8 @@ from typing import Any
 from pymavlink.dialects.v10 import ardupilotmega as mavlink_v1
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
+from sitl.link.packer import FramePacker
+
 MAVLINK2_MAGIC = 0xFD
 SIGNING_KEY_BYTES = 32
 SIGNING_EPOCH_UNIX_S = 1420070400  # MAVLink signing epoch, 2015-01-01
@@ -103,6 +105,7 @@ class MavCodec:
         self.mav.robust_parsing = True
         self.mavlink1_only = mavlink1_only
         self.stats = CodecStats()
+        self._packer = FramePacker(V1_BASE_PAYLOAD_BYTES) if FramePacker.available() else None
 
     def set_signing(self, key: bytes | None, timestamp_s: Callable[[], float]) -> None:
         """Sign outgoing and require signed incoming frames (None turns signing off)."""
@@ -125,7 +128,15 @@ class MavCodec:
 
     def encode(self, msg: Any) -> bytes:
         """Pack one message (sequence and signature applied; MAVLink 1: base payload only)."""
-        self.mav.send(msg, force_mavlink1=self.mavlink1_only)
+        mav = self.mav
+        if self._packer is not None and not mav.signing.sign_outgoing:
+            frame = self._packer.frame(msg, mav.seq, mav.srcSystem, mav.srcComponent,
+                                       self.mavlink1_only)
+            if frame is not None:
+                mav.seq = (mav.seq + 1) % 256
+                self.stats.tx += 1
+                return frame
+        mav.send(msg, force_mavlink1=self.mavlink1_only)
         self.stats.tx += 1
         frame = self._sink.frames.pop()
         return mavlink1_base_frame(frame) if self.mavlink1_only else frame
