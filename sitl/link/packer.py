@@ -19,7 +19,7 @@ from typing import Any
 try:
     from fastcrc.crc16 import mcrf4xx
 except ImportError:  # pymavlink's own fallback is pure Python too slow to be worth it here
-    mcrf4xx = None
+    mcrf4xx = None  # type: ignore[assignment]
 
 _V1 = struct.Struct("<BBBBBB")
 _V2 = struct.Struct("<BBBBBBBHB")
