@@ -224,8 +224,24 @@ class Derived:
     omega_max_ref_radps: float  # loaded rotor speed at ref voltage, full throttle
 
 
-@functools.lru_cache(maxsize=64)
+_derived_of: dict[int, tuple[VehicleParams, Derived]] = {}
+
+
 def derived(p: VehicleParams) -> Derived:
+    """Hot-path constants for `p`, found by identity: the integrator asks 400 times a simulated
+    second, and hashing every field of a frozen dataclass each time was a tenth of its cost."""
+    hit = _derived_of.get(id(p))
+    if hit is not None and hit[0] is p:
+        return hit[1]
+    if len(_derived_of) >= 64:
+        _derived_of.clear()
+    d = _derive(p)
+    _derived_of[id(p)] = (p, d)  # holding p keeps its id from being reused
+    return d
+
+
+@functools.lru_cache(maxsize=64)
+def _derive(p: VehicleParams) -> Derived:
     """Hot-path constants for `p` (cached: params are frozen and hashable)."""
     ixx, iyy, izz = p.inertia_kgm2
     omega_max = p.motor_kv_rpm_per_v * p.ref_voltage_v * p.loaded_speed_fraction * math.pi / 30.0
