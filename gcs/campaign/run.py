@@ -73,7 +73,7 @@ def fly_run(base: BaseFlight, run: RunSpec, output: Path, campaign: str) -> dict
                           takeoff_delay_s=fly_over.get("takeoff_delay_s", base.takeoff_delay_s))
         options = SessionOptions(
             command="fly", profile=str(values.get("profile", base.profile)), world=world_path,
-            seed=int(values.get("seed", 0)), record=base.record,
+            seed=int(values.get("seed", 0)), record=base.record, fix_failsafe=base.fix_failsafe,
             output=output / "flights" / f"{run.run_id}.mcap",
             metadata={"campaign": campaign, "run_id": run.run_id})
         session = LockstepSession(options, world=world_table(world_path, world_over),

@@ -13,6 +13,7 @@
     world = "../worlds/empty_room.toml"   # paths relative to this file
     config = "station.toml"               # a station TOML to start from
     record = false                        # an MCAP per run, in the output's flights/
+    fix_failsafe = false                  # fly's --fix-failsafe (copter4 needs it)
 
     [axes]                           # grid: lists; random: lists or {min, max[, log]}
     seed = { range = [1, 50] }       # integers, both ends included
@@ -50,7 +51,8 @@ from gcs.flight import FlightPlan
 KINDS = ("grid", "random", "search")
 TOP_KEYS = {"name", "kind", "samples", "sample_seed", "fly", "mission", "axes", "search"}
 FLY_KEYS = {"alt_m": float, "hold_s": float, "step_m": float, "takeoff_delay_s": float,
-            "profile": str, "world": str, "config": str, "record": bool}
+            "profile": str, "world": str, "config": str, "record": bool,
+            "fix_failsafe": bool}
 PROFILES = ("apm25", "copter4")
 SEARCH_KEYS = {"trials", "seeds", "worlds", "objective", "failed_penalty"}
 NUMERIC_FLY = ("alt_m", "hold_s", "step_m", "takeoff_delay_s")
@@ -85,6 +87,7 @@ class BaseFlight:
     world: str | None = None  # paths as the file writes them, relative to `root`
     config: str | None = None
     record: bool = False
+    fix_failsafe: bool = False  # fly's --fix-failsafe: copter4 ships FS_GCS_ENABLE = 0
     root: Path = Path(".")  # the campaign file's directory
 
     def resolve(self, text: str | None) -> Path | None:
