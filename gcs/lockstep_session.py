@@ -12,6 +12,7 @@ configuration object instead of files; a pilot's `fly --lockstep` passes files a
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from firmware_link.truth_link import TruthLink
@@ -59,6 +60,9 @@ class LockstepSession(StationSession):
 
     def _open(self) -> None:
         config = self._config if self._config is not None else load_config(self.options.config)
+        # a lockstep loop never waits: at real-time priority it would only take a core from
+        # every other process on the machine (and a Ray worker would keep it for later tasks)
+        config = dataclasses.replace(config, realtime_priority=0)
         for sysid in self.options.sysids:
             self.vehicles[sysid] = self._open_vehicle(sysid, self.sitl.url(sysid),
                                                       self.sitl.mocap, None, config)

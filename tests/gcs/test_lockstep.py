@@ -7,6 +7,7 @@ the link's medium differ, so a seed must give the same recording every time.
 from __future__ import annotations
 
 import hashlib
+import os
 import time
 from pathlib import Path
 
@@ -56,6 +57,14 @@ def test_a_seed_flies_the_same_flight_bit_for_bit(tmp_path: Path) -> None:
     assert first["rms_error_m"] < 0.05
     # a lockstep flight of ~25 simulated seconds is CPU-bound, not paced by the wall clock
     assert cpu_s < 10.0
+
+
+def test_a_lockstep_flight_never_takes_real_time_priority() -> None:
+    policy = os.sched_getscheduler(0) if hasattr(os, "sched_getscheduler") else 0
+    _fly("--seed", "1", "--hold", "1", "--no-record")
+    # a CPU-bound loop at SCHED_FIFO would starve the machine; the TCP loop may have it
+    if hasattr(os, "sched_getscheduler"):
+        assert os.sched_getscheduler(0) == policy
 
 
 def test_the_recording_sits_on_the_fixed_lockstep_timeline(tmp_path: Path) -> None:
