@@ -57,6 +57,10 @@ class SupervisorParams:
     liftoff_lag_s: float = 0.3  # the ramp's last stretch, spent before lift-off was seen
     pickup_band_us: int = 25  # the pilot's throttle takes over within this of the held one
     quit_timeout_s: float = 10.0  # a quitting station waits this long for LAND to show
+    # The firmware disarms by itself once landed with the throttle at minimum this long:
+    # 3.2.1's AUTO_DISARMING_DELAY is a compile-time 15 s; 4.x's DISARM_DELAY defaults to 10 s.
+    # Whatever arms a vehicle on the floor must take off (or disarm it) well before.
+    auto_disarm_s: float = 15.0
 
     def __post_init__(self) -> None:
         if not 0.0 < self.degraded_after_s < self.lost_after_s:
@@ -72,7 +76,8 @@ class SupervisorParams:
         if dialect is Dialect.APM25:
             base = cls()
         elif dialect is Dialect.COPTER4:
-            base = cls(spool_s=3.0, force_disarm=True, stabilize_to_disarm=False)
+            base = cls(spool_s=3.0, force_disarm=True, stabilize_to_disarm=False,
+                       auto_disarm_s=10.0)
         else:
-            base = cls(spool_s=3.0)
+            base = cls(spool_s=3.0, auto_disarm_s=10.0)
         return dataclasses.replace(base, **overrides)  # type: ignore[arg-type]

@@ -232,6 +232,11 @@ class Supervisor:
                 return
             self._note(Level.WARNING, f"altitude hold refused: {why}")
             return
+        if inp.vehicle.seen and not inp.vehicle.armed:
+            # The heartbeat saying so may come before the tick that leaves MANUAL for DISARMED
+            # (intents are applied first): a take-off ramp on a disarmed vehicle winds up.
+            self._note(Level.WARNING, "altitude hold refused: the vehicle is disarmed")
+            return
         if inp.vehicle.mode != FlightMode.STABILIZE:
             self._note(Level.WARNING, "altitude hold refused: the PC flies in STABILIZE, the "
                        f"vehicle is in {_mode_name(inp.vehicle.mode)}")

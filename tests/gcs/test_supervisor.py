@@ -255,6 +255,24 @@ def test_disarm_by_itself_before_takeoff_ends_everything_without_windup() -> Non
     assert out.command is not None and out.command.throttle_us == 1000
 
 
+def test_takeoff_asked_in_the_tick_the_heartbeat_says_disarmed_is_refused() -> None:
+    s = Script()
+    s.armed_in_stabilize()
+    s.run(2.0)
+    s.armed = False  # the firmware's auto-disarm, seen in the same tick as the take-off intent
+    s.heartbeat_now()
+    out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=1.0))
+    assert any(n.text == "altitude hold refused: the vehicle is disarmed" for n in out.notes)
+    assert out.state is S.DISARMED and s.sup.alt is None
+    outs = s.run(5.0)  # no ramp ever starts
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+
+
+def test_auto_disarm_delay_is_known_per_firmware() -> None:
+    assert SupervisorParams.for_dialect(Dialect.APM25).auto_disarm_s == 15.0
+    assert SupervisorParams.for_dialect(Dialect.COPTER4).auto_disarm_s == 10.0
+
+
 def test_takeoff_waits_for_spool_up_then_ramps_until_liftoff_with_no_integrator_growth() -> None:
     s = Script(Dialect.COPTER4)
     s.armed_in_stabilize()
