@@ -9,7 +9,8 @@ nose down (forward) and roll stick HIGH is roll right; the yaw stick commands a 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 
 from firmware_link.records import MocapPose, Quat, RcCommand
 from gcs.estimation import GRAVITY_MPS2
@@ -17,8 +18,14 @@ from gcs.pid import Pid, PidGains
 
 
 def _default_xy_gains() -> PidGains:
-    return PidGains(kp=1.2, ki=0.1, kd=1.6, i_max=0.5, out_min=-2.5, out_max=2.5,
-                    d_filter_hz=3.0, setpoint_slew_per_s=0.7)
+    # The set point moves on a trapezoidal profile (0.7 m/s, 1 m/s²) whose acceleration goes
+    # straight to the lean, and kd damps the rate against the profile's: a jump of the set
+    # point used to leave only P and D to chase it, and the ~0.25 s the attitude takes to follow
+    # the stick made a 0.5 m leg overshoot by 70 % (lockstep, gcs.position_legs: 2.4/1.6 kd and
+    # the profile took it to 55 %, a 2 m leg from 29-32 % to 10-12 %).
+    return PidGains(kp=1.2, ki=0.1, kd=2.4, i_max=0.5, out_min=-2.5, out_max=2.5,
+                    d_filter_hz=3.0, setpoint_slew_per_s=0.7, setpoint_accel_per_s2=1.0,
+                    ff_accel=1.0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,6 +46,24 @@ class PositionControllerParams:
     def __post_init__(self) -> None:
         if not 0.0 < self.max_lean_rad <= self.angle_max_rad:
             raise ValueError("need 0 < max_lean_rad <= angle_max_rad")
+
+
+# What the vehicle's stick mapping is made of: full-stick lean and the roll/pitch deadzones.
+# ArduCopter 3.2.1 ships 45° and 30 µs, 4.7 30° and 20 µs (fixtures' parameter lists); a station
+# that assumed one on the other would lean 2/3 or 3/2 of what it asks for.
+STICK_PARAMS = ("ANGLE_MAX", "RC1_DZ", "RC2_DZ")
+
+
+def with_vehicle_sticks(params: PositionControllerParams,
+                        values: Mapping[str, float]) -> PositionControllerParams:
+    """`params` with the stick mapping the vehicle reported (ANGLE_MAX in centidegrees)."""
+    angle_max = math.radians(values["ANGLE_MAX"] / 100.0)
+    deadzone = round(max(values["RC1_DZ"], values["RC2_DZ"]))
+    if not 0.0 < angle_max <= math.radians(90.0) or not 0 <= deadzone < params.stick_half_range_us:
+        raise ValueError(f"vehicle stick mapping ANGLE_MAX {values['ANGLE_MAX']:g}, "
+                         f"RC1_DZ/RC2_DZ {deadzone} is not one a station can fly")
+    return replace(params, angle_max_rad=angle_max, stick_deadzone_us=deadzone,
+                   max_lean_rad=min(params.max_lean_rad, angle_max))
 
 
 @dataclass(frozen=True, slots=True)

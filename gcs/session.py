@@ -10,6 +10,7 @@ happens in between: overrides released, links closed, files finished, the SITL s
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +30,7 @@ from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import load_config
 from gcs.errors import UsageError
 from gcs.foxglove_feed import DEFAULT_WORLD, FoxgloveFeed, open_live, world_boxes
+from gcs.position_controller import STICK_PARAMS, with_vehicle_sticks
 from gcs.preflight import PreflightReport, read_and_check
 from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlOptions, SitlProcess
@@ -157,6 +159,19 @@ class StationSession:
         return read_and_check(link.get_param, link.set_param, link.dialect, battery_v,
                               fix=self.options.fix_failsafe)
 
+    @staticmethod
+    def _vehicle_sticks(link: VehicleLink, config: Any) -> Any:
+        """The position loop's stick mapping as the vehicle has it (ANGLE_MAX, RC1/2_DZ)."""
+        try:
+            values = link.read_params(STICK_PARAMS)
+            position = with_vehicle_sticks(config.position, values)
+        except ParamError as exc:
+            raise ParamError(f"{exc} (the position hold needs {', '.join(exc.names)})",
+                             exc.names) from None
+        except ValueError as exc:
+            raise ParamError(str(exc), STICK_PARAMS) from None
+        return dataclasses.replace(config, position=position)
+
     @property
     def first(self) -> Vehicle:
         """The vehicle of a single-vehicle session."""
@@ -244,6 +259,8 @@ class StationSession:
             raise ParamError(f"{exc} (the throttle curve needs {', '.join(exc.names)})",
                              exc.names) from None
         curve = ThrottleCurve.for_dialect(link.dialect, params)
+        if mocap_url is not None:
+            config = self._vehicle_sticks(link, config)
         mocap = None
         if mocap_url is not None:
             mocap_link = MocapLink.open(mocap_url, clock=self.clock.now_s)
