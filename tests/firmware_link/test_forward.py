@@ -110,6 +110,17 @@ def tcp_port(fwd: Forwarder) -> int:
     return int(fwd.urls[0].rsplit(":", 1)[1])
 
 
+@pytest.fixture
+def linked(vehicle: FakeVehicle,
+           forwarder: Forwarder) -> Iterator[tuple[VehicleLink, OtherStation]]:
+    """A link to the vehicle through the forwarder, and another station on its TCP port."""
+    link = VehicleLink.open(vehicle.url, forward=forwarder.port(None))
+    station = OtherStation.tcp(tcp_port(forwarder))
+    yield link, station
+    station.close()
+    link.close()
+
+
 @pytest.mark.parametrize("url, words", [
     ("tcp:127.0.0.1:5760", "not understood"),
     ("udpout:127.0.0.1", "missing HOST:PORT"),
@@ -155,9 +166,9 @@ def test_vehicle_frames_go_out_unchanged_and_a_stations_param_set_reaches_the_ve
 
 
 def test_a_stations_overrides_are_refused_while_the_link_writes_the_sticks(
-        vehicle: FakeVehicle, forwarder: Forwarder) -> None:
-    link = VehicleLink.open(vehicle.url, forward=forwarder.port(None))
-    station = OtherStation.tcp(tcp_port(forwarder))
+        vehicle: FakeVehicle, forwarder: Forwarder,
+        linked: tuple[VehicleLink, OtherStation]) -> None:
+    link, station = linked
     theirs = station.mav.rc_channels_override_encode(1, 1, 0, 0, 1800, 0, 0, 0, 0, 0)
     ours = RcCommand(throttle_us=1300)
 
@@ -168,41 +179,33 @@ def test_a_stations_overrides_are_refused_while_the_link_writes_the_sticks(
     def vehicle_saw(sysid: int) -> bool:
         return any(s == sysid for s, _n, _c in vehicle.state.overrides)
 
-    try:
-        records = run_until(link, lambda: forwarder.stats.refused_overrides >= 20, station,
-                            each=both_write)
-        assert vehicle_saw(255) and not vehicle_saw(OTHER_GCS)
-        # reported once, not once per frame
-        assert len(notes(records)) == 1 and "RC override refused" in notes(records)[0]
-        link.release_overrides()
-        run_until(link, lambda: vehicle_saw(OTHER_GCS), station,
-                  each=lambda: station.send(theirs))
-        chans = [c for s, _n, c in vehicle.state.overrides if s == OTHER_GCS]
-        assert chans[-1][2] == 1800  # byte for byte what the other station sent
-    finally:
-        station.close()
-        link.close()
+    records = run_until(link, lambda: forwarder.stats.refused_overrides >= 20, station,
+                        each=both_write)
+    assert vehicle_saw(255) and not vehicle_saw(OTHER_GCS)
+    # reported once, not once per frame
+    assert len(notes(records)) == 1 and "RC override refused" in notes(records)[0]
+    link.release_overrides()
+    run_until(link, lambda: vehicle_saw(OTHER_GCS), station,
+              each=lambda: station.send(theirs))
+    chans = [c for s, _n, c in vehicle.state.overrides if s == OTHER_GCS]
+    assert chans[-1][2] == 1800  # byte for byte what the other station sent
 
 
 def test_a_silent_link_lets_nothing_of_a_station_through(
-        vehicle: FakeVehicle, forwarder: Forwarder) -> None:
-    link = VehicleLink.open(vehicle.url, forward=forwarder.port(None))
-    station = OtherStation.tcp(tcp_port(forwarder))
+        vehicle: FakeVehicle, forwarder: Forwarder,
+        linked: tuple[VehicleLink, OtherStation]) -> None:
+    link, station = linked
     gcs_hb = station.mav.heartbeat_encode(6, 8, 0, 0, 4)
-    try:
-        run_until(link, lambda: forwarder.stats.stations == 1, station)
-        link.set_gcs_heartbeat(False)
-        before = vehicle.state.gcs_heartbeats
-        # the other station's heartbeats would reset the failsafe the silence is for
-        run_until(link, lambda: forwarder.stats.refused_silent >= 10, station,
-                  each=lambda: station.send(gcs_hb))
-        assert vehicle.state.gcs_heartbeats == before
-        link.set_gcs_heartbeat(True)
-        run_until(link, lambda: vehicle.state.gcs_heartbeats >= before + 3, station,
-                  each=lambda: station.send(gcs_hb))
-    finally:
-        station.close()
-        link.close()
+    run_until(link, lambda: forwarder.stats.stations == 1, station)
+    link.set_gcs_heartbeat(False)
+    before = vehicle.state.gcs_heartbeats
+    # the other station's heartbeats would reset the failsafe the silence is for
+    run_until(link, lambda: forwarder.stats.refused_silent >= 10, station,
+              each=lambda: station.send(gcs_hb))
+    assert vehicle.state.gcs_heartbeats == before
+    link.set_gcs_heartbeat(True)
+    run_until(link, lambda: vehicle.state.gcs_heartbeats >= before + 3, station,
+              each=lambda: station.send(gcs_hb))
 
 
 def test_signed_link_keeps_signatures_and_refuses_a_stations_unsigned_frames() -> None:
@@ -252,20 +255,16 @@ def test_udp_stations_out_and_in(vehicle: FakeVehicle) -> None:
 
 
 def test_garbage_from_a_station_is_counted_and_its_next_frame_still_passes(
-        vehicle: FakeVehicle, forwarder: Forwarder) -> None:
-    link = VehicleLink.open(vehicle.url, forward=forwarder.port(None))
-    station = OtherStation.tcp(tcp_port(forwarder))
-    try:
-        frame = bytearray(station.mav.param_set_encode(1, 1, b"ATC_RAT_RLL_P", 0.4, 9)
-                          .pack(station.mav))
-        frame[-1] ^= 0xFF  # a bad CRC
-        station.send_bytes(bytes(frame) + b"\x00\x17garbage")
-        station.send(station.mav.param_set_encode(1, 1, b"ATC_RAT_RLL_P", 0.15, 9))
-        run_until(link, lambda: abs(vehicle.state.params["ATC_RAT_RLL_P"] - 0.15) < 1e-6, station)
-        assert forwarder.stats.bad_frames >= 1
-    finally:
-        station.close()
-        link.close()
+        vehicle: FakeVehicle, forwarder: Forwarder,
+        linked: tuple[VehicleLink, OtherStation]) -> None:
+    link, station = linked
+    frame = bytearray(station.mav.param_set_encode(1, 1, b"ATC_RAT_RLL_P", 0.4, 9)
+                      .pack(station.mav))
+    frame[-1] ^= 0xFF  # a bad CRC
+    station.send_bytes(bytes(frame) + b"\x00\x17garbage")
+    station.send(station.mav.param_set_encode(1, 1, b"ATC_RAT_RLL_P", 0.15, 9))
+    run_until(link, lambda: abs(vehicle.state.params["ATC_RAT_RLL_P"] - 0.15) < 1e-6, station)
+    assert forwarder.stats.bad_frames >= 1
 
 
 def test_a_station_that_stops_reading_costs_dropped_frames_not_a_blocked_loop(
@@ -308,21 +307,17 @@ def test_several_vehicles_share_a_forwarder_by_target_system(forwarder: Forwarde
 
 
 def test_a_stations_stream_rate_requests_are_refused_and_its_commands_pass(
-        vehicle: FakeVehicle, forwarder: Forwarder) -> None:
-    link = VehicleLink.open(vehicle.url, forward=forwarder.port(None))
-    station = OtherStation.tcp(tcp_port(forwarder))
-    try:
-        run_until(link, lambda: forwarder.stats.stations == 1, station)
-        rates_before = dict(vehicle.state.rates_hz)
-        # MAVProxy's default: every stream at 4 Hz, which would starve a 40 Hz loop
-        station.send(station.mav.request_data_stream_encode(1, 1, 0, 4, 1))
-        station.send(station.mav.command_long_encode(1, 1, 511, 0, 30, 250000, 0, 0, 0, 0, 0))
-        station.send(station.mav.command_long_encode(1, 1, 512, 0, 148, 0, 0, 0, 0, 0, 0))
-        records = run_until(
-            link, lambda: any(m.get_type() == "AUTOPILOT_VERSION" for m in station.got), station)
-        assert forwarder.stats.refused_streams == 2
-        assert vehicle.state.rates_hz == rates_before
-        assert any("stream-rate request refused" in n for n in notes(records))
-    finally:
-        station.close()
-        link.close()
+        vehicle: FakeVehicle, forwarder: Forwarder,
+        linked: tuple[VehicleLink, OtherStation]) -> None:
+    link, station = linked
+    run_until(link, lambda: forwarder.stats.stations == 1, station)
+    rates_before = dict(vehicle.state.rates_hz)
+    # MAVProxy's default: every stream at 4 Hz, which would starve a 40 Hz loop
+    station.send(station.mav.request_data_stream_encode(1, 1, 0, 4, 1))
+    station.send(station.mav.command_long_encode(1, 1, 511, 0, 30, 250000, 0, 0, 0, 0, 0))
+    station.send(station.mav.command_long_encode(1, 1, 512, 0, 148, 0, 0, 0, 0, 0, 0))
+    records = run_until(
+        link, lambda: any(m.get_type() == "AUTOPILOT_VERSION" for m in station.got), station)
+    assert forwarder.stats.refused_streams == 2
+    assert vehicle.state.rates_hz == rates_before
+    assert any("stream-rate request refused" in n for n in notes(records))
