@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +31,7 @@ from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import load_config
 from gcs.errors import UsageError
 from gcs.foxglove_feed import DEFAULT_WORLD, FoxgloveFeed, open_live, world_boxes
+from gcs.parallel_open import open_in_parallel
 from gcs.position_controller import STICK_PARAMS, with_vehicle_sticks
 from gcs.preflight import PreflightReport, read_and_check
 from gcs.scoring import Series, station_time
@@ -213,8 +215,10 @@ class StationSession:
             self.forwarder = Forwarder.open(o.forward)
             self._stack.callback(self.forwarder.close)
             print(f"forward: {', '.join(self.forwarder.urls)}", file=sys.stderr, flush=True)
-        for sysid, url in urls.items():
-            self.vehicles[sysid] = self._open_vehicle(sysid, url, mocap_url, key, config)
+        # a vehicle's bring-up waits seconds on the vehicle: every vehicle's at once
+        self.vehicles.update(open_in_parallel(
+            {sysid: functools.partial(self._open_vehicle, sysid, url, mocap_url, key, config)
+             for sysid, url in urls.items()}, self._stack))
         truth_url = getattr(self.sitl_endpoints, "truth", None)
         if truth_url is not None:
             for sysid, v in self.vehicles.items():
@@ -222,7 +226,10 @@ class StationSession:
                 self._stack.callback(v.truth.close)
 
     def _open_vehicle(self, sysid: int, url: str, mocap_url: str | None, key: bytes | None,
-                      config: Any) -> Vehicle:
+                      config: Any, stack: contextlib.ExitStack | None = None) -> Vehicle:
+        """One vehicle (on its own thread, see `_open`): what it opens is undone through
+        `stack` (default: the session's)."""
+        stack = self._stack if stack is None else stack
         o = self.options
         recorder = None
         if o.record:
@@ -235,7 +242,7 @@ class StationSession:
                                     anchor_ns=self.recording_anchor_ns)
             except RecordingError as exc:
                 raise UsageError(f"-o {o.output}: {exc}") from None
-            self._stack.callback(recorder.close)
+            stack.callback(recorder.close)
         sink = None
         if recorder is not None or self.live is not None:
             world = o.world if o.world is not None or o.connect is not None else DEFAULT_WORLD
@@ -248,7 +255,7 @@ class StationSession:
                                 target_system=sysid if o.connect is None else None,
                                 on_raw=sink.put_raw if sink is not None else None,
                                 forward=forward)
-        self._stack.callback(link.close)
+        stack.callback(link.close)
         link.bring_up(STREAM_RATE_HZ)
         # The throttle curve is how the station turns a thrust into a stick: a default in place
         # of the vehicle's own value would fly a wrong curve, so a failed read stops here.
@@ -264,7 +271,7 @@ class StationSession:
         mocap = None
         if mocap_url is not None:
             mocap_link = MocapLink.open(mocap_url, clock=self.clock.now_s)
-            self._stack.callback(mocap_link.close)
+            stack.callback(mocap_link.close)
             mocap = MocapFor(mocap_link, sysid)
         station = Station(link, config=config, curve=curve, mocap=mocap, recorder=sink,
                           clock=self.clock)
@@ -272,6 +279,6 @@ class StationSession:
         self.preflight[sysid] = report
         station.preflight(report.ok, report.summary())
         # registered last, so it stops first: the loop releases overrides before links close
-        self._stack.callback(station.stop)
+        stack.callback(station.stop)
         return Vehicle(sysid=sysid, url=url, link=link, station=station, recorder=recorder,
                        sink=sink)

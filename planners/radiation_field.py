@@ -25,7 +25,10 @@ class PointSource:
 
 @dataclass(frozen=True, slots=True)
 class RadiationField:
-    """Sum of softened inverse-square sources plus a uniform background, in counts/s."""
+    """Sum of softened inverse-square sources plus a uniform background, in counts/s.
+
+    A floor with no source at all is a field too (background only): mapping it must say so.
+    """
 
     sources: tuple[PointSource, ...]
     background_cps: float
@@ -34,8 +37,6 @@ class RadiationField:
 
     def __post_init__(self) -> None:
         """Reject fields that cannot be sampled."""
-        if not self.sources:
-            raise ValueError("a radiation field needs at least one source")
         if any(s.strength_cps_at_1m <= 0.0 for s in self.sources):
             raise ValueError("source strengths must be positive (counts/s at 1 m)")
         if self.background_cps < 0.0:
@@ -62,7 +63,7 @@ class RadiationField:
     @property
     def source_xy_m(self) -> np.ndarray:
         """Source positions as an (n, 2) array (x north, y east)."""
-        return np.array([[s.x_m, s.y_m] for s in self.sources], dtype=float)
+        return np.array([[s.x_m, s.y_m] for s in self.sources], dtype=float).reshape(-1, 2)
 
     def intensity(self, x_m: np.ndarray | float, y_m: np.ndarray | float) -> np.ndarray:
         """Expected counts/s at horizontal position(s) (x_m, y_m) at the flight height."""

@@ -133,6 +133,7 @@ class RadiationMapper:
         self._last: Decision | None = None
         self._status: Status | None = None
         self._reason = ""
+        self._budget_spent = False
 
     # ----- public API -------------------------------------------------------------------------
 
@@ -140,6 +141,11 @@ class RadiationMapper:
     def done(self) -> bool:
         """True once the mapper has finished (or given up)."""
         return self._status is not None
+
+    @property
+    def budget_spent(self) -> bool:
+        """True when the run ended because its sample budget was spent, not its survey done."""
+        return self._budget_spent
 
     @property
     def status(self) -> Status | None:
@@ -224,6 +230,7 @@ class RadiationMapper:
             self._finish(Status.REACHED if self._ev.hotspots else Status.FAILED, str(stop.value))
             return self._decision(pos, Phase.DONE, self._reason)
         if len(self._ev.cps) >= self.max_samples:
+            self._budget_spent = True
             self._finish(Status.FAILED, f"sample budget of {self.max_samples} spent")
             return self._decision(pos, Phase.DONE, self._reason)
         return self._decision(ask.pos_n, ask.phase, ask.reason)

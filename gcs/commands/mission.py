@@ -3,7 +3,8 @@
 With no `--connect` it starts the bundled SITL with the file's world and vehicles; `--kinematic`
 runs the same planner with exact moves (seconds). A line per planner step goes to stderr while
 it runs (not with `--quiet`); the summary (or with `--json` one JSON object) goes to stdout.
-Exit 0 when the goal is met, 3 when the mission failed, 2 for bad input, 1 for runtime faults.
+Exit 0 when the goal is met (or an unscored run finished: nothing to score it against), 3 when
+the mission failed, 2 for bad input, 1 for runtime faults.
 """
 
 from __future__ import annotations
@@ -44,6 +45,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--fix-failsafe", action="store_true",
                    help="let the station set the vehicles' GCS failsafe parameters when the "
                         "pre-flight checks find them unsafe; without it such a vehicle is refused")
+    r.add_argument("--no-truth", dest="truth", action="store_false",
+                   help="keep the world's sources and boxes from the station and the planner "
+                        "(the SITL or kinematic world still simulates them) and score nothing "
+                        "against them: as on a real floor")
     add_forward_argument(r)
     add_foxglove_argument(r)
     r.add_argument("--json", action="store_true", help="print the result as one JSON object")
@@ -70,12 +75,13 @@ def run(args: argparse.Namespace) -> int:
     options = RunOptions(kinematic=args.kinematic, connect=args.connect, mocap=args.mocap,
                          record=args.record, output=args.output, plot=args.plot,
                          speedup=args.speedup, seed=args.seed, fix_failsafe=args.fix_failsafe,
-                         foxglove=args.foxglove, forward=tuple(args.forward))
+                         foxglove=args.foxglove, forward=tuple(args.forward),
+                         truth=args.truth)
     report = run_mission(spec, options, None if (args.quiet or args.json) else _progress)
     if args.json:
         print(report.to_json(), flush=True)
     else:
         print("\n".join(report.summary_lines()), flush=True)
-    if not report.reached:
+    if not report.ok:
         raise MissionFailed(f"mission {spec.name} failed: {report.reason}")
     return 0

@@ -21,3 +21,6 @@ class RunOptions:
     fix_failsafe: bool = False  # the pilot's consent to set unsafe GCS-failsafe parameters
     foxglove: str | None = None  # [HOST:]PORT: serve the mission live to Foxglove
     forward: tuple[str, ...] = ()  # other ground stations sharing the vehicles
+    # False (--no-truth): the station and the planner never see the world's sources or boxes
+    # (the SITL or the kinematic world still simulates them) and nothing is scored against them
+    truth: bool = True

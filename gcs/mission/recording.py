@@ -78,7 +78,8 @@ class MissionRecording:
             self._planned(t_s, step_setpoints(topic, payload, self._last_z_n))
 
     def _planned(self, t_s: float, setpoints: dict[int, tuple[float, float, float]]) -> None:
-        if not setpoints:
+        recorder = self.recorder
+        if not setpoints or recorder is None:
             return
         spheres = []
         for sysid, p in setpoints.items():
@@ -87,10 +88,10 @@ class MissionRecording:
                 trail.append(p)
             spheres.append(scene_entity(f"vehicle{sysid}_setpoint",
                                         spheres=[scene_sphere(p, 0.12, SETPOINT_COLOR)]))
-        self.recorder.put(SETPOINT, t_s, foxglove_scene(spheres))
+        recorder.put(SETPOINT, t_s, foxglove_scene(spheres))
         if t_s >= self._next_path_s:
             self._next_path_s = t_s + PATH_EVERY_S
-            self.recorder.put(PATH, t_s, foxglove_scene(
+            recorder.put(PATH, t_s, foxglove_scene(
                 scene_entity(f"vehicle{sysid}_path",
                              lines=[scene_line_strip(trail, 0.03, PATH_COLOR)])
                 for sysid, trail in self._paths.items() if len(trail) >= 2))

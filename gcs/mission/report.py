@@ -14,6 +14,9 @@ class MissionStatus(enum.Enum):
 
     REACHED = "reached"
     FAILED = "failed"
+    # flown to the end and its products made, with nothing to judge them against (no truth:
+    # a real floor, a world without [[sources]], or --no-truth): not a failure, not a success
+    UNSCORED = "unscored"
 
 
 class RunMode(enum.Enum):
@@ -55,6 +58,11 @@ class MissionReport:
     def reached(self) -> bool:
         """True when the mission's goal was met."""
         return self.status is MissionStatus.REACHED
+
+    @property
+    def ok(self) -> bool:
+        """True when the command should exit 0: the goal met, or an unscored run finished."""
+        return self.status in (MissionStatus.REACHED, MissionStatus.UNSCORED)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object: the fixed keys first, then the planner's own metrics."""

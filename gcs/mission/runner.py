@@ -18,7 +18,7 @@ from gcs.mission.kinematic import (
 )
 from gcs.mission.options import RunOptions
 from gcs.mission.planner_params import planner_setup
-from gcs.mission.plot import write_radiation_plot
+from gcs.mission.plot import write_radiation_products
 from gcs.mission.recording import SUMMARY, MissionRecording
 from gcs.mission.report import MissionReport
 from gcs.mission.spec import MissionSpec, PlannerKind
@@ -72,8 +72,10 @@ def run_mission(spec: MissionSpec, options: RunOptions,
         elif spec.planner is PlannerKind.FLOCKING:
             report = run_flock_kinematic(spec, mw, setup, rec, progress)
         else:
-            report, products = run_radiation_kinematic(spec, mw, setup, rec, progress)
+            report, products = run_radiation_kinematic(spec, mw, setup, rec, progress,
+                                                       truth=options.truth)
         rec.put(SUMMARY, time.monotonic(), report.to_dict())
-    if spec.planner is PlannerKind.RADIATION and products is not None:
-        report.metrics["plot"] = write_radiation_plot(spec, options, report, products)
+    if spec.planner is PlannerKind.RADIATION and products is not None \
+            and products[1] is not None:
+        report.metrics.update(write_radiation_products(spec, options, report, products))
     return report

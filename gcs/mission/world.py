@@ -36,10 +36,14 @@ class MissionWorld:
     background_cps: float
     start_positions_n: tuple[Vec3, ...]
 
+    @property
+    def has_truth(self) -> bool:
+        """Whether the world says where its sources are (a map can be scored against them)."""
+        return bool(self.sources)
+
     def radiation_field(self, height_m: float = 1.0) -> RadiationField:
-        """The world's sources as an analytic field, read `height_m` above the floor."""
-        if not self.sources:
-            raise UsageError(f"world {self.name}: a radiation mission needs [[sources]]")
+        """The world's sources as an analytic field, read `height_m` above the floor (the
+        background alone on a world without [[sources]])."""
         return RadiationField.from_tuples(
             [(s.pos_n[0], s.pos_n[1], s.strength_cps) for s in self.sources],
             background_cps=self.background_cps,

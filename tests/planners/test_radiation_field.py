@@ -40,7 +40,7 @@ def test_grid_rows_follow_y() -> None:
 
 @pytest.mark.parametrize(
     ("sources", "background", "kw"),
-    [([], 1.0, {}), ([(0, 0, -1.0)], 1.0, {}), ([(0, 0, 1.0)], -1.0, {}),
+    [([(0, 0, -1.0)], 1.0, {}), ([(0, 0, 1.0)], -1.0, {}),
      ([(0, 0, 1.0)], 1.0, {"height_m": -1.0})],
 )  # fmt: skip
 def test_bad_fields_are_rejected(sources: list, background: float, kw: dict) -> None:
@@ -72,3 +72,10 @@ def test_counting_stops_once_the_target_counts_are_in() -> None:
     assert dwell == pytest.approx(0.4)
     with pytest.raises(ValueError, match="window_s"):
         f.count((0.0, 0.0), rng, max_dwell_s=0.1, target_counts=10, window_s=0.2)
+
+
+def test_a_floor_without_sources_reads_the_background_everywhere() -> None:
+    f = RadiationField.from_tuples([], 20.0)
+    assert f.source_xy_m.shape == (0, 2)
+    g = f.grid(np.linspace(-5.0, 5.0, 4), np.linspace(-5.0, 5.0, 3))
+    assert np.allclose(g, 20.0)

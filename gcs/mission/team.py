@@ -1,0 +1,248 @@
+"""The vehicles of one mission flown as a team: armed together, off together, landed, watched.
+
+Arming is the dangerous wait. A firmware disarms a vehicle that stands armed on the floor with
+the throttle at minimum (ArduCopter 3.2.1 after 15 s, 4.x after DISARM_DELAY), so arming one
+vehicle after another and taking off once the last is ready loses the first. Here every vehicle
+is put in STABILIZE and left to rest together, asked to arm in one go, and the take-off follows
+the moment the last one is armed; should that take longer than the shortest auto-disarm allows,
+every vehicle is disarmed and the mission fails before anything leaves the floor.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Callable
+
+from firmware_link.records import FlightMode
+from gcs.errors import RuntimeFault
+from gcs.mission.craft import Craft, CraftPhase, go_to_all
+from gcs.mission.events import EventLog, MissionEvent
+from gcs.mission.recording import MissionRecording
+from gcs.mission.spec import MissionSpec
+from gcs.station import StationSnapshot
+from gcs.supervisor import SupervisorState
+from planners.geometry import Vec3
+
+POSITION_HOLD_FROM_M = 0.3  # take-off: hold position only once clear of the floor's friction
+CLIMB_MPS = 0.4
+DESCENT_MPS = 0.3
+HANDOVER_ALT_M = 0.15  # below this (estimate), LAND mode finishes the touch-down
+STILL_MPS = 0.05  # sinking slower than this (mocap) for STILL_S: standing on something
+STILL_S = 1.0
+REST_S = 3.0  # disarmed on the floor first: the estimators learn the accelerometer bias at rest
+MODE_TIMEOUT_S = 10.0
+# Take-off must be asked this long before the first-armed vehicle's auto-disarm: the request
+# reaches the vehicle on the next tick, and the throttle has to leave minimum there.
+AUTO_DISARM_MARGIN_S = 5.0
+POLL_S = 0.1
+
+
+class Team:
+    """The crafts of one mission and the steps they take together."""
+
+    def __init__(self, spec: MissionSpec, crafts: dict[int, Craft], rec: MissionRecording,
+                 events: EventLog) -> None:
+        """Fly `crafts` (started stations) under `spec`, recording into `rec`, telling `events`
+        what happens."""
+        self.spec = spec
+        self.crafts = crafts
+        self.rec = rec
+        self.events = events
+        self.clock = next(iter(crafts.values())).station.clock
+        self.t_start = self.clock.now_s()
+        self.min_separation_m = math.inf
+        self.armed_at_s: dict[int, float] = {}
+
+    def event(self, what: MissionEvent, vehicle: int | None = None, detail: str = "") -> None:
+        """Tell the pilot and the recording."""
+        self.events(self.clock.now_s(), what, vehicle, detail)
+
+    def say(self, line: str) -> None:
+        """A progress line for the pilot."""
+        self.events.say(line)
+
+    def elapsed_s(self) -> float:
+        """Station time since the team was formed."""
+        return self.clock.now_s() - self.t_start
+
+    def over_budget(self) -> bool:
+        """True once the mission's time is spent."""
+        return self.elapsed_s() > self.spec.max_duration_s
+
+    def watch_separation(self) -> None:
+        """Between looks: the smallest distance between any two vehicles (mocap)."""
+        if len(self.crafts) < 2:
+            return
+        pos = [c.snapshot().mocap for c in self.crafts.values()]
+        pts = [p.pos_n for p in pos if p is not None]
+        for a, b in itertools.combinations(pts, 2):
+            self.min_separation_m = min(self.min_separation_m, math.dist(a, b))
+
+    def auto_disarm_s(self) -> float:
+        """The shortest auto-disarm delay of the team's firmwares."""
+        return min(c.station.supervisor_params.auto_disarm_s for c in self.crafts.values())
+
+    # ------------------------------------------------------------------ arming
+    def _wait_all(self, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> list[int]:
+        """Poll until `pred` holds for every vehicle; the vehicles it did not, on timeout."""
+        deadline = self.clock.now_s() + timeout_s
+        while True:
+            late = [v for v, c in self.crafts.items() if not pred(c.snapshot())]
+            if not late or self.clock.now_s() >= deadline:
+                return late
+            time.sleep(POLL_S)
+
+    def arm(self) -> None:
+        """STABILIZE, rest, then arm every vehicle at once (see the module's docstring)."""
+        for c in self.crafts.values():
+            c.station.set_sticks(1500, 1500, 1500, 1000)
+            c.station.set_mode(FlightMode.STABILIZE)
+
+        def in_stabilize(s: StationSnapshot) -> bool:
+            return s.vehicle_mode == FlightMode.STABILIZE
+
+        late = self._wait_all(in_stabilize, MODE_TIMEOUT_S)
+        if late:
+            raise RuntimeFault(f"arming: vehicles {late} did not switch to STABILIZE within "
+                               f"{MODE_TIMEOUT_S:g} s")
+        self.clock.sleep_until(self.clock.now_s() + REST_S)
+        asked_at = self.clock.now_s()
+        self.event(MissionEvent.ARMING, detail=f"{len(self.crafts)} vehicle(s) together")
+        for c in self.crafts.values():
+            c.station.request_arm()
+        budget_s = self.auto_disarm_s() - AUTO_DISARM_MARGIN_S
+        deadline = asked_at + budget_s
+        refused: dict[int, str] = {}
+        while True:
+            now = self.clock.now_s()
+            for v, c in self.crafts.items():
+                snap = c.snapshot()
+                if snap.armed and snap.state is SupervisorState.MANUAL:
+                    self.armed_at_s.setdefault(v, now)
+                words = [e.text for e in snap.events if e.t_s >= asked_at and e.text.startswith(
+                    ("arm refused", "disarmed: vehicle did not arm"))]
+                if words:
+                    refused[v] = words[-1]
+            ready = len(self.armed_at_s) == len(self.crafts)
+            first = min(self.armed_at_s.values(), default=now)
+            if ready and now - first <= budget_s:
+                self.event(MissionEvent.ARMED,
+                           detail=f"all within {now - first:.1f} s of the first")
+                return
+            if refused or now >= deadline or now - first > budget_s:
+                self.disarm_all()
+                late = sorted(set(self.crafts) - set(self.armed_at_s))
+                why = "; ".join(f"vehicle {v}: {t}" for v, t in sorted(refused.items()))
+                raise RuntimeFault(
+                    f"arming: vehicles {late} not armed within {budget_s:g} s of the request "
+                    f"(the firmware disarms on the floor after {self.auto_disarm_s():g} s); "
+                    f"every vehicle disarmed" + (f" ({why})" if why else ""))
+            time.sleep(POLL_S)
+
+    def disarm_all(self) -> None:
+        """Disarm every vehicle on the floor (throttle minimum first)."""
+        for c in self.crafts.values():
+            c.station.set_sticks(1500, 1500, 1500, 1000)
+            c.station.request_disarm()
+        self.event(MissionEvent.DISARMED_ON_FLOOR)
+
+    # ------------------------------------------------------------------ take-off
+    def take_off(self) -> dict[int, Vec3]:
+        """Arm together, climb together to the take-off altitude above where each stands; the
+        commanded hover points."""
+        alt = self.spec.takeoff_alt_m
+        self.arm()
+        hover: dict[int, Vec3] = {}
+        for v, c in self.crafts.items():
+            here = c.position_n()
+            hover[v] = (here[0], here[1], -alt)
+            c.phase = CraftPhase.TAKEOFF
+            c.station.alt_hold(True, alt, rate_mps=CLIMB_MPS)
+        self.event(MissionEvent.TAKING_OFF, detail=f"to {alt:.2f} m")
+        deadline = self.clock.now_s() + alt / CLIMB_MPS + 20.0
+        holding: set[int] = set()
+        while True:
+            for v, c in self.crafts.items():
+                est = c.snapshot().estimate
+                if v not in holding and est is not None and est.alt_m > POSITION_HOLD_FROM_M:
+                    c.command(hover[v])
+                    holding.add(v)
+            if len(holding) == len(self.crafts):
+                break
+            if self.clock.now_s() > deadline:
+                raise RuntimeFault(f"take-off: vehicles {sorted(set(self.crafts) - holding)} "
+                                   f"did not leave the floor")
+            time.sleep(POLL_S)
+        settled = go_to_all(self.crafts, hover, self.spec.position_tolerance_m,
+                            self.spec.settle_s, alt / CLIMB_MPS + 15.0, self.watch_separation)
+        late = [v for v, ok in settled.items() if not ok]
+        if late:
+            raise RuntimeFault(f"take-off: vehicles {late} did not settle at {alt:.2f} m")
+        for c in self.crafts.values():
+            c.phase = CraftPhase.MISSION
+        self.event(MissionEvent.AIRBORNE)
+        return hover
+
+    # ------------------------------------------------------------------ flying
+    def go(self, targets: dict[int, Vec3], timeout_s: float | None = None) -> dict[int, Vec3]:
+        """Fly to the targets; what the planner should take as each vehicle's position."""
+        settled = go_to_all(self.crafts, targets, self.spec.position_tolerance_m,
+                            self.spec.settle_s, timeout_s or self.spec.step_timeout_s,
+                            self.watch_separation)
+        out: dict[int, Vec3] = {}
+        for v, target in targets.items():
+            if settled[v]:
+                out[v] = target
+            else:  # where it is, in the room's frame (the sonar estimate is over furniture)
+                out[v] = self.crafts[v].position_n()
+        return out
+
+    # ------------------------------------------------------------------ landing
+    def land(self) -> None:
+        """Land every vehicle, one after the other, where it is (see `_land_one`)."""
+        for v, c in self.crafts.items():
+            c.phase = CraftPhase.LAND
+            self.event(MissionEvent.LANDING, v)
+            self._land_one(c)
+            self.event(MissionEvent.LANDED, v)
+
+    def _land_one(self, c: Craft) -> None:
+        """Descend under PC control until near the surface below or no longer sinking, then
+        LAND mode touches down and disarms (a disarm request follows if it does not).
+
+        Over a box the sonar-based estimate may still be measured from the floor, so it never
+        falls below the hand-over height: motion capture seeing no descent for a second ends the
+        PC descent too.
+        """
+        st = c.station
+        c.release()
+        st.alt_hold(True, 0.0, rate_mps=DESCENT_MPS)
+        deadline = self.clock.now_s() + self.spec.takeoff_alt_m / DESCENT_MPS + 20.0
+        still_since: float | None = None
+        last: tuple[float, float] | None = None  # (station time, mocap z)
+        while self.clock.now_s() < deadline:
+            snap = c.snapshot()
+            now = self.clock.now_s()
+            if snap.estimate is not None and snap.estimate.alt_m < HANDOVER_ALT_M:
+                break
+            z = snap.mocap.pos_n[2] if snap.mocap is not None else None
+            if z is not None and last is not None and now > last[0]:
+                sinking_mps = (z - last[1]) / (now - last[0])
+                if sinking_mps < STILL_MPS:
+                    still_since = now if still_since is None else still_since
+                    if now - still_since >= STILL_S:
+                        break
+                else:
+                    still_since = None
+            if z is not None:
+                last = (now, z)
+            time.sleep(POLL_S)
+        st.set_sticks(1500, 1500, 1500, 1000)
+        st.set_mode(FlightMode.LAND)  # PC hold stays on until a heartbeat shows LAND
+        for _ in range(4):
+            if c.wait(lambda s: not s.armed, 10.0):
+                return
+            st.request_disarm()
+        raise RuntimeFault(f"vehicle {c.sysid} did not disarm after landing")

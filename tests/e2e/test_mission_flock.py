@@ -1,0 +1,67 @@
+"""Five vehicles of the flock mission on the bundled SITL at 2x: up together, armed together,
+off together, every vehicle at its goal, checked against truth, every recording whole."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from gcs.mission import recording as topics
+from gcs.mission.events import EVENT
+from logs import Recording, open_recording
+
+MISSION = Path(__file__).resolve().parents[2] / "missions" / "flock_table.toml"
+AUTO_DISARM_S = 15.0  # ArduCopter 3.2.1 (the mission's profile) on the floor at minimum throttle
+
+
+def _states(rec: Recording) -> dict[str, float]:
+    """Station time of each supervisor state's first entry."""
+    first: dict[str, float] = {}
+    for _, _, m in rec.messages(["/gcs/supervisor"]):
+        first.setdefault(m["state"], m["t_s"])
+    return first
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(420)
+def test_five_vehicles_fly_the_flock_to_its_goals_at_2x(tmp_path: Path) -> None:
+    # a fresh process, as a user runs it: the station's loops share nothing with other tests
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "mission", "run", str(MISSION), "--speedup", "2",
+         "--seed", "3", "--json", "-o", str(tmp_path)],
+        capture_output=True, text=True, timeout=400, check=False)
+    out = proc.stdout.strip().splitlines()
+    assert out, f"exit {proc.returncode}: {proc.stderr.strip()}"
+    d = json.loads(out[-1])
+    assert proc.returncode == 0, d
+    assert d["status"] == "reached" and d["mode"] == "vehicle" and d["vehicles"] == 5
+    assert all(t is not None for t in d["time_to_goal_s"].values())
+    # bodies against the world's boxes from the SITL's ground truth, take-off to landing
+    assert d["collision_source"] == "truth" and d["truth_samples"] > 5000
+    assert d["collisions"] == 0 and d["touched"] == []
+    assert len(d["recordings"]) == 5
+    took_off: list[float] = []
+    armed: list[float] = []
+    for path in d["recordings"]:
+        rec = open_recording(path)  # raises on a truncated file: every one was closed
+        first = _states(rec)
+        # the whole flight: pre-flight, armed, take-off, PC hold, LAND, disarmed
+        assert {"arming", "manual", "takeoff", "hold", "vehicle", "disarmed"} <= set(first)
+        assert first["takeoff"] - first["manual"] < AUTO_DISARM_S - 5.0
+        armed.append(first["manual"])
+        took_off.append(first["takeoff"])
+        assert rec.counts["/gcs/rc_override"] > 2000 and rec.counts["/vehicle/heartbeat"] > 50
+        assert rec.counts["/mavlink/rx"] > 10_000 and rec.counts["/mavlink/tx"] > 1000
+        assert rec.counts["/gcs/tick"] > 2000
+    # armed within a second of each other, off the floor together
+    assert max(armed) - min(armed) < 1.0 and max(took_off) - min(took_off) < 1.0
+    team = open_recording(d["recording"])
+    steps = [m for _, _, m in team.messages([topics.STEP_FLOCK])]
+    assert len(steps) == d["steps"] + 1 and team.counts[topics.SUMMARY] == 1
+    events = [m["event"] for _, _, m in team.messages([EVENT])]
+    assert events[:5] == ["session_ready", "arming", "armed", "taking_off", "airborne"]
+    assert events.count("landed") == 5
