@@ -62,6 +62,9 @@ class LockstepOptions:
     noise: bool = True
     truth: bool = False
     signing_key: bytes | None = None
+    # the vehicle links' faults (sitl.lockstep.LinkFaults's fields: loss, fade, fade_start_s,
+    # fade_s; seeded from `seed`), None: a clean link
+    faults: dict[str, Any] | None = None
 
 
 class BundledLockstep:
@@ -72,14 +75,16 @@ class BundledLockstep:
         try:
             self.sitl = module.start(options.profile, options.world, options.vehicles,
                                      options.seed, options.noise, options.signing_key)
-        except (ValueError, OSError) as exc:
+            faults = (None if options.faults is None
+                      else module.LinkFaults(**{"seed": options.seed, **options.faults}))
+        except (ValueError, OSError, TypeError) as exc:
             where = f"--world {options.world}: " if isinstance(options.world, Path) else ""
             raise UsageError(f"{where}{exc}") from None
         self.clock = LockstepClock(self.sitl)
         self._prefix = f"lockstep{next(_instances)}"
         self._names: list[str] = []
-        self.vehicles = {s: self._plug(f"vehicle{s}", self.sitl.vehicle_port(s))
-                         for s in range(1, options.vehicles + 1)}
+        self.ports = {s: self.sitl.vehicle_port(s, faults) for s in range(1, options.vehicles + 1)}
+        self.vehicles = {s: self._plug(f"vehicle{s}", p) for s, p in self.ports.items()}
         self.mocap = (self._plug("mocap", self.sitl.mocap_port())
                       if self.sitl.mocap_enabled else None)
         self.truth = self._plug("truth", self.sitl.truth_port()) if options.truth else None

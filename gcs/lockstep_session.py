@@ -33,7 +33,8 @@ class LockstepSession(StationSession):
     recording_anchor_ns = LOCKSTEP_EPOCH_NS
 
     def __init__(self, options: SessionOptions, *, world: Any = None,
-                 config: StationConfig | None = None, noise: bool = True) -> None:
+                 config: StationConfig | None = None, noise: bool = True,
+                 faults: dict[str, Any] | None = None) -> None:
         self._refuse(options)
         self._world = world if world is not None else options.world
         self._config = config
@@ -41,7 +42,7 @@ class LockstepSession(StationSession):
         truth = options.command in SCORED_COMMANDS or options.metadata.get("truth") == "on"
         self.sitl = BundledLockstep(LockstepOptions(
             profile=options.profile, world=self._world, vehicles=max(options.sysids),
-            seed=options.seed or 0, noise=noise, truth=truth, signing_key=None))
+            seed=options.seed or 0, noise=noise, truth=truth, signing_key=None, faults=faults))
         super().__init__(options)
         self._stack.callback(self.sitl.close)
         self.clock = self.sitl.clock

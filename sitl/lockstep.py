@@ -17,10 +17,14 @@ than `PORT_BACKLOG_BYTES` behind loses what does not fit.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from sitl.autopilot import AutopilotOptions, Profile
+from sitl.fault_frames import FrameSplitter
 from sitl.link.channel import Channel
 from sitl.mocap_server import MocapEncoder
 from sitl.params import ParamError
@@ -36,21 +40,92 @@ class PortClosed(OSError):
     """The port was closed (by either side)."""
 
 
+FADES = ("none", "down", "up", "both")
+
+
+@dataclass(frozen=True, slots=True)
+class LinkFaults:
+    """What a vehicle port suffers, on simulated time (the fault proxy's faults, in lockstep).
+
+    `fade` loses every byte of one way ("down": vehicle to station, "up", or "both") from
+    `fade_start_s` for `fade_s` simulated seconds, a radio fade; `loss` loses each whole frame
+    with that probability both ways, from the port's own seeded generator."""
+
+    loss: float = 0.0
+    fade: str = "none"
+    fade_start_s: float = 0.0
+    fade_s: float = 0.0
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.fade not in FADES:
+            raise ValueError(f"fade {self.fade!r}: expected one of {', '.join(FADES)}")
+        if not 0.0 <= self.loss < 1.0:
+            raise ValueError(f"loss {self.loss}: expected a probability in [0, 1)")
+        if self.fade_s < 0.0 or self.fade_start_s < 0.0:
+            raise ValueError("fade_start_s and fade_s: expected seconds >= 0")
+
+    def faded(self, way: str, t_s: float) -> bool:
+        """Whether way "down" or "up" is in its fade at `t_s`."""
+        return (self.fade in (way, "both")
+                and self.fade_start_s <= t_s < self.fade_start_s + self.fade_s)
+
+
+class _Lossy:
+    """One way of a faulty port: whole frames through or lost, as the faults say."""
+
+    def __init__(self, faults: LinkFaults, way: str, rng: np.random.Generator) -> None:
+        self.faults = faults
+        self.way = way
+        self._rng = rng
+        self._split = FrameSplitter()
+        self.lost_frames = 0
+
+    def through(self, data: bytes, t_s: float) -> bytes:
+        """What of `data` gets across at `t_s`."""
+        f = self.faults
+        if f.faded(self.way, t_s):
+            self.lost_frames += sum(ok for ok, _ in self._split.feed(data))
+            return b""
+        if f.loss <= 0.0:
+            return data
+        out = bytearray()
+        for ok, chunk in self._split.feed(data):
+            if ok and self._rng.random() < f.loss:
+                self.lost_frames += 1
+            else:
+                out += chunk
+        return bytes(out)
+
+
 class MemoryPort:
     """One connection point: what the simulation sent waits here until read; what is written
     goes to the simulation at once."""
 
     def __init__(self, owner: LockstepSitl, name: str,
-                 receive: Callable[[bytes], None] | None) -> None:
+                 receive: Callable[[bytes], None] | None,
+                 faults: LinkFaults | None = None) -> None:
         self.owner = owner
         self.name = name
         self._receive = receive
         self._rx = bytearray()
         self.dropped_bytes = 0
         self.closed = False
+        self._down = self._up = None
+        if faults is not None:
+            down, up = np.random.default_rng(faults.seed).spawn(2)
+            self._down, self._up = _Lossy(faults, "down", down), _Lossy(faults, "up", up)
+
+    @property
+    def lost_frames(self) -> tuple[int, int]:
+        """Frames the faults lost (down, up)."""
+        return (self._down.lost_frames if self._down else 0,
+                self._up.lost_frames if self._up else 0)
 
     def deliver(self, data: bytes) -> None:
         """Queue bytes for the reader (dropped when it is that far behind)."""
+        if self._down is not None and data:
+            data = self._down.through(data, self.owner.t_s)
         if not data or self.closed:
             return
         if len(self._rx) + len(data) > PORT_BACKLOG_BYTES:
@@ -75,8 +150,11 @@ class MemoryPort:
         """Hand `data` to the simulation (all of it); PortClosed once closed."""
         if self.closed:
             raise PortClosed(f"{self.name}: closed")
-        if self._receive is not None:
-            self._receive(bytes(data))
+        sent = bytes(data)
+        if self._up is not None:
+            sent = self._up.through(sent, self.owner.t_s)
+        if self._receive is not None and sent:
+            self._receive(sent)
         return len(data)
 
     def wait_readable(self, timeout_s: float) -> None:
@@ -117,12 +195,13 @@ class LockstepSitl:
         return bool(self.sim.world.mocap_enabled)
 
     # ------------------------------------------------------------------ ports
-    def vehicle_port(self, sysid: int = 1) -> MemoryPort:
-        """A new link to vehicle `sysid` (SR0_* stream rates, like the TCP endpoint)."""
+    def vehicle_port(self, sysid: int = 1, faults: LinkFaults | None = None) -> MemoryPort:
+        """A new link to vehicle `sysid` (SR0_* stream rates, like the TCP endpoint), with
+        `faults` on it if given."""
         rt = self.sim.vehicle(sysid)
         ch = rt.add_channel(0, f"memory{len(rt.link.channels)}")
         port = MemoryPort(self, f"vehicle{sysid}/{ch.name}",
-                          lambda data: rt.link.receive(ch, data))
+                          lambda data: rt.link.receive(ch, data), faults)
         self._vehicle_ports.append((ch, port))
         return port
 
@@ -164,6 +243,8 @@ class LockstepSitl:
         sim = self.sim
         sim.tick()
         self.ticks += 1
+        # what the tick sent leaves at the tick's time (a fade's window is judged on it)
+        self._now_s = max(self._now_s, sim.t_s)
         for ch, port in self._vehicle_ports:
             if port.closed:
                 ch.discard_output()

@@ -42,10 +42,12 @@ def make_run(base: BaseFlight, values: dict[str, Any]) -> RunSpec:
     return RunSpec(run_id(base, values), dict(values))
 
 
-def _split(values: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any], dict[str, float]]:
+def _split(values: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any], dict[str, float],
+                                            dict[str, Any]]:
     world: dict[str, Any] = {}
     station: dict[str, Any] = {}
     fly: dict[str, float] = {}
+    link: dict[str, Any] = {}
     for name, v in values.items():
         if name.startswith("world."):
             set_dotted(world, name.removeprefix("world."), v)
@@ -53,7 +55,9 @@ def _split(values: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any], dict
             set_dotted(station, name.removeprefix("station."), v)
         elif name.startswith("fly."):
             fly[name.removeprefix("fly.")] = float(v)
-    return world, station, fly
+        elif name.startswith("link."):
+            link[name.removeprefix("link.")] = v
+    return world, station, fly, link
 
 
 def fly_run(base: BaseFlight, run: RunSpec, output: Path, campaign: str) -> dict[str, Any]:
@@ -64,7 +68,7 @@ def fly_run(base: BaseFlight, run: RunSpec, output: Path, campaign: str) -> dict
     c0, w0 = time.process_time(), time.perf_counter()
     values = run.values
     try:
-        world_over, station_over, fly_over = _split(values)
+        world_over, station_over, fly_over, faults = _split(values)
         world_path = base.resolve(values["world"]) if "world" in values else base.world_path
         config = config_from_table(station_table(base.config_path, station_over))
         plan = FlightPlan(alt_m=fly_over.get("alt_m", base.alt_m),
@@ -77,7 +81,7 @@ def fly_run(base: BaseFlight, run: RunSpec, output: Path, campaign: str) -> dict
             output=output / "flights" / f"{run.run_id}.mcap",
             metadata={"campaign": campaign, "run_id": run.run_id})
         session = LockstepSession(options, world=world_table(world_path, world_over),
-                                  config=config)
+                                  config=config, faults=faults or None)
         with session:
             summary = fly_session(session, plan, pilot_signals=False)
             sim_s = session.clock.now_s()

@@ -22,6 +22,9 @@
     world = ["../worlds/empty_room.toml", "../worlds/carpet_room.toml"]
     profile = ["apm25", "copter4"]
     "fly.alt_m" = [0.5, 1.0]         # any key of [fly] that is a number
+    "link.fade" = ["none", "down", "up", "both"]  # a radio fade of the vehicle link, and its
+    "link.fade_start_s" = [30.0]     # start and length in simulated s (holding from ~15 s);
+    "link.fade_s" = [15.0]           # "link.loss" = [0.0, 0.05]: each frame lost, both ways
 
     [search]                         # kind = "search": Optuna TPE over the axes
     trials = 30
@@ -43,7 +46,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gcs.campaign.tables import check_world, set_dotted, world_table
+from gcs.campaign.tables import check_faults, check_world, set_dotted, world_table
 from gcs.config import config_from_table
 from gcs.errors import UsageError
 from gcs.flight import FlightPlan
@@ -56,6 +59,7 @@ FLY_KEYS = {"alt_m": float, "hold_s": float, "step_m": float, "takeoff_delay_s":
 PROFILES = ("apm25", "copter4")
 SEARCH_KEYS = {"trials", "seeds", "worlds", "objective", "failed_penalty"}
 NUMERIC_FLY = ("alt_m", "hold_s", "step_m", "takeoff_delay_s")
+LINK_KEYS = ("loss", "fade", "fade_start_s", "fade_s")
 
 
 class CampaignError(UsageError):
@@ -299,9 +303,18 @@ def _axis(p: Path, base: BaseFlight, kind: str, name: str, raw: Any) -> Axis:
             _check_station(p, at, name.removeprefix("station."), v)
         elif name.startswith("world."):
             _check_world(p, at, base.world_path, set_dotted({}, name.removeprefix("world."), v))
+        elif name.startswith("link."):
+            field_name = name.removeprefix("link.")
+            if field_name not in LINK_KEYS:
+                raise _fail(p, key, f"unknown axis; expected link.{{{', '.join(LINK_KEYS)}}}")
+            try:
+                check_faults({field_name: v})
+            except (TypeError, ValueError) as exc:
+                raise _fail(p, at, f"{exc}") from None
         else:
             raise _fail(p, key, "unknown axis; expected seed, profile, world, fly.KEY, "
-                        "station.KEY (a station TOML key) or world.KEY (a world TOML key)")
+                        "station.KEY (a station TOML key), world.KEY (a world TOML key) or "
+                        "link.KEY (link faults)")
     return axis
 
 

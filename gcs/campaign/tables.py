@@ -57,6 +57,11 @@ def check_world(table: Mapping[str, Any]) -> None:
     importlib.import_module("sitl.lockstep").world_of(table)
 
 
+def check_faults(faults: Mapping[str, Any]) -> None:
+    """Let the SITL judge a link-fault table (ValueError or TypeError, one line)."""
+    importlib.import_module("sitl.lockstep").LinkFaults(**faults)
+
+
 def station_table(config: Path | None, over: Mapping[str, Any]) -> dict[str, Any]:
     """The station file's table (empty when None) with `over` merged in."""
     return merged(read_table(config) if config is not None else {}, over)

@@ -77,6 +77,9 @@ world = ["../../worlds/empty_room.toml"]
     ('kind = "search"\n[axes]\n"station.altitude.gains.kp" = [1.0]\n[search]\nobjective = "x"',
      "search.objective: expected one of ['rms_error_m'"),
     ("axes = 3 = 4", "not valid TOML"),
+    ('[axes]\n"link.fade" = ["sideways"]',
+     "axes.link.fade[0]: fade 'sideways': expected one of none, down, up, both"),
+    ('[axes]\n"link.jitter" = [1.0]', "axes.link.jitter: unknown axis; expected link.{loss"),
 ])
 def test_bad_files_are_one_line(tmp_path: Path, text: str, needle: str) -> None:
     path = _file(tmp_path, text)

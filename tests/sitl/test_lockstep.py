@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
-from sitl.lockstep import PORT_BACKLOG_BYTES, PortClosed, start
+from sitl.lockstep import PORT_BACKLOG_BYTES, LinkFaults, MemoryPort, PortClosed, start
 
 
 def _decode(data: bytes) -> list[mavlink.MAVLink_message]:
@@ -96,3 +96,57 @@ def test_a_closed_port_refuses_and_is_no_longer_fed() -> None:
 def test_bad_profile_is_one_line() -> None:
     with pytest.raises(ValueError, match="profile 'apm26': expected one of apm25, copter4"):
         start("apm26")
+
+
+def _heartbeats(port: MemoryPort) -> list[float]:
+    return [m.get_type() for m in _decode(port.read(PORT_BACKLOG_BYTES))].count("HEARTBEAT")
+
+
+def test_a_fade_loses_one_way_for_its_window_only() -> None:
+    sitl = start(seed=1)
+    port = sitl.vehicle_port(1, LinkFaults(fade="down", fade_start_s=1.0, fade_s=2.0))
+    gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+    seen = []
+    for second in range(4):
+        sitl.advance_to(second + 0.995)
+        seen.append(_heartbeats(port))
+    # 1 Hz heartbeats: one in each second but the two faded ones
+    assert seen == [1, 0, 0, 1] and port.lost_frames[0] > 2 and port.lost_frames[1] == 0
+    # the uplink is untouched by a downlink fade: a request in the fade is answered after it
+    sitl2 = start(seed=1)
+    port2 = sitl2.vehicle_port(1, LinkFaults(fade="up", fade_start_s=0.0, fade_s=1.0))
+    req = mavlink.MAVLink_param_request_read_message(1, 1, b"SYSID_THISMAV", -1)
+    port2.write(req.pack(gcs, force_mavlink1=True))
+    sitl2.advance_to(1.5)
+    assert "PARAM_VALUE" not in {m.get_type() for m in _decode(port2.read(PORT_BACKLOG_BYTES))}
+    port2.write(req.pack(gcs, force_mavlink1=True))
+    sitl2.advance_to(1.6)
+    assert "PARAM_VALUE" in {m.get_type() for m in _decode(port2.read(PORT_BACKLOG_BYTES))}
+    assert port2.lost_frames == (0, 1)
+
+
+def test_frame_loss_is_whole_frames_at_its_rate_from_its_seed() -> None:
+    def run(seed: int) -> tuple[int, int, bytes]:
+        sitl = start(seed=1)
+        port = sitl.vehicle_port(1, LinkFaults(loss=0.2, seed=seed))
+        clean = sitl.vehicle_port(1)
+        gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+        for p in (port, clean):
+            p.write(mavlink.MAVLink_request_data_stream_message(1, 1, 0, 40, 1)
+                    .pack(gcs, force_mavlink1=True))
+        sitl.advance_to(3.0)
+        got = port.read(PORT_BACKLOG_BYTES)
+        return len(_decode(got)), len(_decode(clean.read(PORT_BACKLOG_BYTES))), got
+
+    kept, total, data = run(3)
+    # every byte that arrives is part of a whole, good frame
+    assert sum(len(m.get_msgbuf()) for m in _decode(data)) == len(data)
+    assert 0.7 * total < kept < 0.9 * total
+    assert run(3)[2] == data and run(4)[2] != data
+
+
+def test_bad_faults_are_one_line() -> None:
+    with pytest.raises(ValueError, match="fade 'sideways': expected one of none, down, up"):
+        LinkFaults(fade="sideways")
+    with pytest.raises(ValueError, match=r"loss 1.5: expected a probability in \[0, 1\)"):
+        LinkFaults(loss=1.5)
