@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from gcs.campaign.run import fly_run, make_run
@@ -19,3 +20,56 @@ def test_a_downlink_fade_in_the_hold_is_a_failed_row_naming_the_lost_link(tmp_pa
     assert row["status"] == "failed" and row["link.fade"] == "down"
     assert "nothing heard from the vehicle for 1.5 s" in row["reason"]
     assert row["cpu_s"] > 0.0 and row["worker"]
+
+
+class _Ref:
+    def __init__(self, value: dict) -> None:
+        self.value = value
+
+
+class InterruptedRay:
+    """Ray's calls as the driver uses them; the pilot presses Ctrl-C after `finish` rows."""
+
+    def __init__(self, finish: int) -> None:
+        self.finish = finish
+        self.cancelled = 0
+
+    def remote(self, **_: object) -> Callable[[object], type]:
+        class Task:
+            @staticmethod
+            def remote(*args: object) -> _Ref:
+                return _Ref(_row(args[1]))  # (base, run, output, campaign)
+        return lambda fn: Task
+
+    def wait(self, refs: list, num_returns: int, timeout: float) -> tuple[list, list]:
+        if self.finish == 0:
+            raise KeyboardInterrupt
+        self.finish -= 1
+        return refs[:1], refs[1:]
+
+    def get(self, ref: _Ref) -> dict:
+        return ref.value
+
+    def cancel(self, ref: _Ref, force: bool) -> None:
+        self.cancelled += 1
+
+
+def _row(run: object) -> dict:
+    from gcs.campaign.metrics import flown_row
+
+    return flown_row(run.run_id, run.values, {"rms_error_m": 0.01, "error_source": "truth"})
+
+
+def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_flies_the_rest(tmp_path: Path) -> None:
+    from gcs.campaign import load_campaign, read_results, run_campaign
+
+    path = tmp_path / "c.toml"
+    path.write_text("[axes]\nseed = { range = [1, 5] }\n", encoding="utf-8")
+    c = load_campaign(path)
+    ray = InterruptedRay(finish=2)
+    first = run_campaign(c, tmp_path / "out", ray, quiet=True)
+    assert not first.complete and first.ran == 2 and ray.cancelled == 3
+    assert [r["seed"] for r in read_results(first.results)] == [1, 2]
+    second = run_campaign(c, tmp_path / "out", InterruptedRay(finish=10), quiet=True)
+    assert second.complete and (second.ran, second.skipped) == (3, 2)
+    assert sorted(r["seed"] for r in read_results(second.results)) == [1, 2, 3, 4, 5]
