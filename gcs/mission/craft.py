@@ -67,9 +67,12 @@ def yaw_of(q_nb: tuple[float, float, float, float]) -> float:
 class Craft:
     """A started station plus the mission's view of its vehicle."""
 
-    def __init__(self, sysid: int, station: Station) -> None:
+    def __init__(self, sysid: int, station: Station, truth: bool = True) -> None:
+        """The mission's view of `station`'s vehicle; `truth` False: the SITL's ground truth
+        (SIM_STATE), should the vehicle send it, is not kept (`--no-truth`)."""
         self.sysid = sysid
         self.station = station
+        self.keeps_truth = truth
         self.phase = CraftPhase.GROUND
         self._lock = threading.Lock()
         self._b = _Books()
@@ -88,7 +91,8 @@ class Craft:
                 b.radiation.append(r)
             elif isinstance(r, MocapPose):
                 b.last_mocap = r.pos_n
-            elif isinstance(r, SimTruth) and all(math.isfinite(c) for c in r.pos_n):
+            elif (isinstance(r, SimTruth) and self.keeps_truth
+                  and all(math.isfinite(c) for c in r.pos_n)):
                 b.truth.append(TruthSample(r.t_s, r.pos_n, self.phase))
                 if b.last_mocap is not None and self.phase is CraftPhase.GROUND:
                     b.mocap_at_truth.append((b.last_mocap, r.pos_n))

@@ -64,7 +64,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         crafts: dict[int, Craft] = {}
         for sysid in sysids:
             vehicle = session.vehicles[sysid]
-            crafts[sysid] = Craft(sysid, vehicle.station)
+            crafts[sysid] = Craft(sysid, vehicle.station, truth=options.truth)
             vehicle.station.start()
         rec = _MultiRecording({s: session.vehicles[s].sink for s in sysids})
         # the room's bounds are the planner's to know; the boxes in it only with the truth

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 from collections.abc import Callable
 
 from firmware_link.records import FlightMode
@@ -80,6 +79,10 @@ class Team:
         for a, b in itertools.combinations(pts, 2):
             self.min_separation_m = min(self.min_separation_m, math.dist(a, b))
 
+    def _pause(self) -> None:
+        """Between looks at the stations: rarely, every look takes the GIL from the loops."""
+        self.clock.sleep_until(self.clock.now_s() + POLL_S)
+
     def auto_disarm_s(self) -> float:
         """The shortest auto-disarm delay of the team's firmwares."""
         return min(c.station.supervisor_params.auto_disarm_s for c in self.crafts.values())
@@ -92,7 +95,7 @@ class Team:
             late = [v for v, c in self.crafts.items() if not pred(c.snapshot())]
             if not late or self.clock.now_s() >= deadline:
                 return late
-            time.sleep(POLL_S)
+            self._pause()
 
     def arm(self) -> None:
         """STABILIZE, rest, then arm every vehicle at once (see the module's docstring)."""
@@ -139,7 +142,7 @@ class Team:
                     f"arming: vehicles {late} not armed within {budget_s:g} s of the request "
                     f"(the firmware disarms on the floor after {self.auto_disarm_s():g} s); "
                     f"every vehicle disarmed" + (f" ({why})" if why else ""))
-            time.sleep(POLL_S)
+            self._pause()
 
     def disarm_all(self) -> None:
         """Disarm every vehicle on the floor (throttle minimum first)."""
@@ -174,7 +177,7 @@ class Team:
             if self.clock.now_s() > deadline:
                 raise RuntimeFault(f"take-off: vehicles {sorted(set(self.crafts) - holding)} "
                                    f"did not leave the floor")
-            time.sleep(POLL_S)
+            self._pause()
         settled = go_to_all(self.crafts, hover, self.spec.position_tolerance_m,
                             self.spec.settle_s, alt / CLIMB_MPS + 15.0, self.watch_separation)
         late = [v for v, ok in settled.items() if not ok]
@@ -238,7 +241,7 @@ class Team:
                     still_since = None
             if z is not None:
                 last = (now, z)
-            time.sleep(POLL_S)
+            self._pause()
         st.set_sticks(1500, 1500, 1500, 1000)
         st.set_mode(FlightMode.LAND)  # PC hold stays on until a heartbeat shows LAND
         for _ in range(4):
