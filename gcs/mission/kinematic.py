@@ -61,9 +61,17 @@ def _at_altitude(p: Vec3, alt_m: float) -> Vec3:
     return (p[0], p[1], -alt_m)
 
 
+def _books(collisions: int, truth: bool) -> tuple[int, dict[str, Any]]:
+    """The simulator's collision count where the run may know the world's boxes, else none."""
+    return (collisions, {"collision_source": "truth"}) if truth else \
+        (0, {"collision_source": "none"})
+
+
 def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
-                        rec: MissionRecording, progress: Progress | None) -> MissionReport:
-    """EPBHA from the take-off point to the goal with exact moves."""
+                        rec: MissionRecording, progress: Progress | None,
+                        truth: bool = True) -> MissionReport:
+    """EPBHA from the take-off point to the goal with exact moves (the boxes are simulated
+    whatever `truth` says; without it they are neither recorded nor counted against)."""
     wall0 = time.monotonic()
     t0 = time.monotonic()
     params = setup.params
@@ -76,7 +84,7 @@ def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
     sim = KinematicSim(mw.world, start, KinematicParams(), prox, rng)
     planner = Epbha(params, goal, start)
     dt = params.step_m / NOMINAL_SPEED_MPS
-    rec.scene(t0, mw.world.room, mw.world.obstacles)
+    rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
     status, reason = MissionStatus.FAILED, f"no goal after {setup.max_steps} steps"
     obstacles: dict[str, int] = {}
     k = 0
@@ -104,14 +112,16 @@ def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
         reason = (f"planner stopped {math.dist(sim.pos_n, goal):.2f} m from the goal "
                   f"(tolerance {spec.goal_tolerance_m} m)")
     path_len = sum(math.dist(a, b) for a, b in zip(sim.path, sim.path[1:], strict=False))
+    collisions, books = _books(sim.collisions, truth)
     return MissionReport(
         mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC, status=status,
-        reason=reason, collisions=sim.collisions, path_length_m=path_len,
+        reason=reason, collisions=collisions, path_length_m=path_len,
         duration_s=k * dt, wall_s=time.monotonic() - wall0, steps=len(sim.path) - 1,
         recording=rec.path,
         metrics={
+            **books,
             "cost_evaluations": planner.cost_evaluations,
-            "min_clearance_m": sim.min_clearance_m,
+            "min_clearance_m": sim.min_clearance_m if truth else None,
             "final_pos_n": list(sim.pos_n),
             "goal_error_m": math.dist(sim.pos_n, goal),
             "obstacle_steps": obstacles,
@@ -171,14 +181,16 @@ def flock_scene(spec: MissionSpec, mw: MissionWorld) -> FlockScene:
 
 
 def run_flock_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
-                        rec: MissionRecording, progress: Progress | None) -> MissionReport:
-    """The triangular flock with exact moves; the runner keeps the safety books."""
+                        rec: MissionRecording, progress: Progress | None,
+                        truth: bool = True) -> MissionReport:
+    """The triangular flock with exact moves; the runner keeps the safety books, reported
+    only with `truth` (the boxes, and where the vehicles really were)."""
     wall0 = time.monotonic()
     t0 = time.monotonic()
     scene = flock_scene(spec, mw)
     prm = FlockRunParams(dt_s=setup.params.step_m / NOMINAL_SPEED_MPS,
                          proximity=ProximityParams(rings=1, noise_sigma_m=setup.noise_sigma_m))
-    rec.scene(t0, mw.world.room, mw.world.obstacles)
+    rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
 
     def factory(sc: FlockScene, ids: list[int]) -> _RecordedFlock:
         goals = {ids[k]: g for k, g in sc.individual_goals_n.items() if k < len(ids)}
@@ -195,25 +207,27 @@ def run_flock_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
         v: float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))) if len(p) > 1 else 0.0
         for v, p in res.paths_n.items()
     }
-    reached = res.status.value == "reached" and res.collisions == 0
-    reason = res.reason if res.collisions == 0 else f"{res.reason}; {res.collisions} collisions"
+    collisions, books = _books(res.collisions, truth)
+    reached = res.status.value == "reached" and collisions == 0
+    reason = res.reason if collisions == 0 else f"{res.reason}; {collisions} collisions"
     return MissionReport(
         mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC,
         status=MissionStatus.REACHED if reached else MissionStatus.FAILED, reason=reason,
-        collisions=res.collisions, path_length_m=sum(lengths.values()),
+        collisions=collisions, path_length_m=sum(lengths.values()),
         duration_s=res.steps * res.dt_s, wall_s=time.monotonic() - wall0, steps=res.steps,
         recording=rec.path,
         metrics={
+            **books,
             "vehicles": res.n_vehicles,
             "min_separation_m": res.min_separation_m,
-            "min_clearance_m": res.min_clearance_m,
+            "min_clearance_m": res.min_clearance_m if truth else None,
             "messages_sent": res.messages_sent,
             "state_reads": res.state_reads,
             "messages_total": res.messages_total,
             "formation_error_m": res.formation_error_m,
             "time_to_goal_s": {str(v): res.time_to_goal_s(v) for v in res.steps_to_goal},
             "path_length_per_vehicle_m": {str(v): x for v, x in lengths.items()},
-            "obstacle_collisions": res.obstacle_collisions,
+            "obstacle_collisions": res.obstacle_collisions if truth else None,
             "vehicle_collisions": res.vehicle_collisions,
         },
     )

@@ -68,9 +68,9 @@ def run_mission(spec: MissionSpec, options: RunOptions,
         rec = MissionRecording(recorder if recorder is not None else live)
         products: Any = None
         if spec.planner is PlannerKind.EPBHA:
-            report = run_epbha_kinematic(spec, mw, setup, rec, progress)
+            report = run_epbha_kinematic(spec, mw, setup, rec, progress, truth=options.truth)
         elif spec.planner is PlannerKind.FLOCKING:
-            report = run_flock_kinematic(spec, mw, setup, rec, progress)
+            report = run_flock_kinematic(spec, mw, setup, rec, progress, truth=options.truth)
         else:
             report, products = run_radiation_kinematic(spec, mw, setup, rec, progress,
                                                        truth=options.truth)

@@ -66,3 +66,15 @@ def test_a_world_without_sources_is_mapped_and_reported_unscored(
     m = read_map(Path(d["map"]))
     # the background alone: the map's mean sits near 50 cps over the whole floor
     assert 35.0 < float(m.mean_cps.mean()) < 70.0
+
+
+@pytest.mark.parametrize("mission", ["epbha_table.toml", "flock_table.toml"])
+def test_obstacle_missions_without_the_truth_record_no_boxes_and_count_nothing(
+        mission: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, d = run_json(capsys, str(ROOT / "missions" / mission), "--kinematic", "--no-truth",
+                       "-o", str(tmp_path))
+    assert code == 0 and d["status"] == "reached"  # the planners need only bounds and goals
+    assert d["collision_source"] == "none" and d["min_clearance_m"] is None
+    rec = open_recording(d["recording"])
+    scene = next(m for _, _, m in rec.messages([topics.SCENE]))
+    assert [len(e["cubes"]) for e in scene["entities"]] == [1]  # the room's shell alone
