@@ -27,6 +27,7 @@ class BytePipe(Protocol):
 
     closed: bool
 
+    def connect(self) -> None: ...  # a client opened it, as a TCP accept: send from now on
     def read(self, max_bytes: int) -> bytes: ...
     def write(self, data: bytes | memoryview) -> int: ...
     def wait_readable(self, timeout_s: float) -> None: ...
@@ -64,6 +65,7 @@ class MemoryTransport:
         pipe = _pipes.get(spec.host)
         if pipe is None or pipe.closed:
             raise LinkError(f"{spec.url}: no in-memory port of that name in this process")
+        pipe.connect()
         return cls(spec, pipe)
 
     def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes:

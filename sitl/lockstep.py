@@ -111,6 +111,7 @@ class MemoryPort:
         self._rx = bytearray()
         self.dropped_bytes = 0
         self.closed = False
+        self.connected = False  # as a TCP endpoint: nothing is sent before a client comes
         self._down = self._up = None
         if faults is not None:
             down, up = np.random.default_rng(faults.seed).spawn(2)
@@ -122,11 +123,18 @@ class MemoryPort:
         return (self._down.lost_frames if self._down else 0,
                 self._up.lost_frames if self._up else 0)
 
+    def connect(self) -> None:
+        """A client opened the port: from now on it gets what the simulation sends (before,
+        nobody was there to get it, as with a TCP endpoint that has no client)."""
+        self.connected = True
+
     def deliver(self, data: bytes) -> None:
         """Queue bytes for the reader (dropped when it is that far behind)."""
-        if self._down is not None and data:
+        if not self.connected or self.closed or not data:
+            return
+        if self._down is not None:
             data = self._down.through(data, self.owner.t_s)
-        if not data or self.closed:
+        if not data:
             return
         if len(self._rx) + len(data) > PORT_BACKLOG_BYTES:
             self.dropped_bytes += len(data)

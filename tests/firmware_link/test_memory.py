@@ -17,6 +17,10 @@ class Pipe:
         self.closed = False
         self.buf = bytearray()
         self.waited_s = 0.0
+        self.connected = False
+
+    def connect(self) -> None:
+        self.connected = True
 
     def read(self, max_bytes: int) -> bytes:
         if self.closed:
@@ -50,7 +54,9 @@ def test_bytes_both_ways_and_waiting_is_the_far_end_s() -> None:
     pipe = Pipe()
     url = memory.plug("test-echo", pipe)
     try:
+        assert not pipe.connected
         t = open_transport(parse_connection_string(url))
+        assert pipe.connected  # the far end knows a client came, as a TCP accept tells it
         assert t.write(b"\xfe\x09abc") == 5
         t.wait_readable(0.01)
         assert pipe.waited_s == pytest.approx(0.01)

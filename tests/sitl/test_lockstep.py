@@ -9,6 +9,12 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink
 from sitl.lockstep import PORT_BACKLOG_BYTES, LinkFaults, MemoryPort, PortClosed, start
 
 
+def _open(port: MemoryPort) -> MemoryPort:
+    """The port with a client on it, as the station's link opening it does."""
+    port.connect()
+    return port
+
+
 def _decode(data: bytes) -> list[mavlink.MAVLink_message]:
     parser = mavlink.MAVLink(None)
     return [m for m in parser.parse_buffer(data) or [] if m.get_type() != "BAD_DATA"]
@@ -26,7 +32,7 @@ def test_time_moves_only_when_asked_and_never_back() -> None:
 
 def test_waiting_for_bytes_stops_at_the_tick_that_sent_them() -> None:
     sitl = start(seed=1)
-    port = sitl.vehicle_port(1)
+    port = _open(sitl.vehicle_port(1))
     port.wait_readable(5.0)
     # the autopilot's first heartbeat goes out on its first tick: not five seconds later
     assert port.readable and sitl.t_s == pytest.approx(0.01)
@@ -38,7 +44,7 @@ def test_waiting_for_bytes_stops_at_the_tick_that_sent_them() -> None:
 
 def test_a_request_written_is_answered_on_the_same_port() -> None:
     sitl = start(seed=1)
-    port = sitl.vehicle_port(1)
+    port = _open(sitl.vehicle_port(1))
     gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
     req = mavlink.MAVLink_param_request_read_message(1, 1, b"SYSID_THISMAV", -1)
     port.write(req.pack(gcs, force_mavlink1=True))
@@ -51,7 +57,7 @@ def test_a_request_written_is_answered_on_the_same_port() -> None:
 
 def test_truth_and_mocap_ports_stream_at_their_rates() -> None:
     sitl = start(seed=1)
-    truth, mocap = sitl.truth_port(), sitl.mocap_port()
+    truth, mocap = _open(sitl.truth_port()), _open(sitl.mocap_port())
     sitl.advance_to(1.0)
     reports = [m for m in _decode(truth.read(PORT_BACKLOG_BYTES))
                if m.get_type() == "LOCAL_POSITION_NED"]
@@ -66,7 +72,7 @@ def test_truth_and_mocap_ports_stream_at_their_rates() -> None:
 def test_same_seed_same_bytes_other_seed_other_bytes() -> None:
     def run(seed: int) -> bytes:
         sitl = start(seed=seed)
-        port = sitl.vehicle_port(1)
+        port = _open(sitl.vehicle_port(1))
         gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
         port.write(mavlink.MAVLink_request_data_stream_message(1, 1, 0, 40, 1)
                    .pack(gcs, force_mavlink1=True))
@@ -84,7 +90,7 @@ def test_same_seed_same_bytes_other_seed_other_bytes() -> None:
 
 def test_a_closed_port_refuses_and_is_no_longer_fed() -> None:
     sitl = start(seed=1)
-    port = sitl.vehicle_port(1)
+    port = _open(sitl.vehicle_port(1))
     port.close()
     sitl.advance_to(0.5)
     with pytest.raises(PortClosed):
@@ -104,7 +110,7 @@ def _heartbeats(port: MemoryPort) -> list[float]:
 
 def test_a_fade_loses_one_way_for_its_window_only() -> None:
     sitl = start(seed=1)
-    port = sitl.vehicle_port(1, LinkFaults(fade="down", fade_start_s=1.0, fade_s=2.0))
+    port = _open(sitl.vehicle_port(1, LinkFaults(fade="down", fade_start_s=1.0, fade_s=2.0)))
     gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
     seen = []
     for second in range(4):
@@ -114,7 +120,7 @@ def test_a_fade_loses_one_way_for_its_window_only() -> None:
     assert seen == [1, 0, 0, 1] and port.lost_frames[0] > 2 and port.lost_frames[1] == 0
     # the uplink is untouched by a downlink fade: a request in the fade is answered after it
     sitl2 = start(seed=1)
-    port2 = sitl2.vehicle_port(1, LinkFaults(fade="up", fade_start_s=0.0, fade_s=1.0))
+    port2 = _open(sitl2.vehicle_port(1, LinkFaults(fade="up", fade_start_s=0.0, fade_s=1.0)))
     req = mavlink.MAVLink_param_request_read_message(1, 1, b"SYSID_THISMAV", -1)
     port2.write(req.pack(gcs, force_mavlink1=True))
     sitl2.advance_to(1.5)
@@ -128,8 +134,8 @@ def test_a_fade_loses_one_way_for_its_window_only() -> None:
 def test_frame_loss_is_whole_frames_at_its_rate_from_its_seed() -> None:
     def run(seed: int) -> tuple[int, int, bytes]:
         sitl = start(seed=1)
-        port = sitl.vehicle_port(1, LinkFaults(loss=0.2, seed=seed))
-        clean = sitl.vehicle_port(1)
+        port = _open(sitl.vehicle_port(1, LinkFaults(loss=0.2, seed=seed)))
+        clean = _open(sitl.vehicle_port(1))
         gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
         for p in (port, clean):
             p.write(mavlink.MAVLink_request_data_stream_message(1, 1, 0, 40, 1)
@@ -150,3 +156,16 @@ def test_bad_faults_are_one_line() -> None:
         LinkFaults(fade="sideways")
     with pytest.raises(ValueError, match=r"loss 1.5: expected a probability in \[0, 1\)"):
         LinkFaults(loss=1.5)
+
+
+def test_a_port_nobody_opened_gets_nothing_as_a_tcp_endpoint_without_a_client() -> None:
+    sitl = start(seed=1)
+    early, late = sitl.mocap_port(), sitl.mocap_port()
+    early.connect()
+    sitl.advance_to(2.0)
+    late.connect()
+    sitl.advance_to(2.5)
+    n_early = len(_decode(early.read(PORT_BACKLOG_BYTES)))
+    n_late = len(_decode(late.read(PORT_BACKLOG_BYTES)))
+    # 100 Hz poses: the late client has only the half second since it came
+    assert n_early > 190 and 45 <= n_late <= 51

@@ -7,12 +7,19 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 from sitl.link.codec import MavCodec
 from sitl.link.packer import FramePacker
-from sitl.lockstep import PORT_BACKLOG_BYTES, start
+from sitl.lockstep import PORT_BACKLOG_BYTES, MemoryPort, start
+
+
+def _open(port: MemoryPort) -> MemoryPort:
+    """The port with a client on it, as the station's link opening it does."""
+    port.connect()
+    return port
 
 
 def _streamed(profile: str) -> list[mavlink.MAVLink_message]:
     sitl = start(profile, seed=2)
-    port, mocap, truth = sitl.vehicle_port(1), sitl.mocap_port(), sitl.truth_port()
+    port, mocap, truth = (_open(p) for p in (sitl.vehicle_port(1), sitl.mocap_port(),
+                                             sitl.truth_port()))
     gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
     v1 = profile == "apm25"
     for msg in (mavlink.MAVLink_heartbeat_message(6, 8, 0, 0, 4, 3),
