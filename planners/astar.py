@@ -12,7 +12,7 @@ import math
 import time
 from collections.abc import Callable
 
-from planners.geometry import Vec3, World
+from planners.geometry import Vec3, World, as_vec3
 from planners.grid import DIRECTIONS, Grid, GridParams
 from planners.kinematic import KinematicParams, KinematicSim
 from planners.result import PlanResult, PlanStatus
@@ -79,7 +79,7 @@ def plan_astar(
     grid = Grid(world, start_n, grid_params)
     start, goal = grid.nearest(start_n), grid.nearest(goal_n)
     if start is None or goal is None or not grid.is_free(start) or not grid.is_free(goal):
-        return PlanResult("A*", PlanStatus.START_BLOCKED, (tuple(start_n),), 0, 0,
+        return PlanResult("A*", PlanStatus.START_BLOCKED, (as_vec3(start_n),), 0, 0,
                           (cpu_clock() - t0,), world.clearance(start_n), 0,
                           "start or goal is within the body radius of an obstacle or wall")
     nodes, expansions, evaluations = astar_search(grid, start, goal)

@@ -6,6 +6,8 @@ separate parts are the separate hotspots and whose holes are dips inside them.
 
 from __future__ import annotations
 
+from typing import Any, cast
+
 import contourpy
 import numpy as np
 import shapely
@@ -13,7 +15,8 @@ from shapely.geometry import MultiPolygon, Polygon
 from shapely.geometry.base import BaseGeometry
 
 
-def _generator(xs_m: np.ndarray, ys_m: np.ndarray, z: np.ndarray, **kw: object) -> object:
+def _generator(xs_m: np.ndarray, ys_m: np.ndarray, z: np.ndarray,
+               **kw: Any) -> contourpy.ContourGenerator:
     """contourpy generator for z indexed [iy, ix]."""
     z = np.asarray(z, dtype=float)
     if z.shape != (len(ys_m), len(xs_m)):
@@ -25,7 +28,9 @@ def region_above(xs_m: np.ndarray, ys_m: np.ndarray, z: np.ndarray, level: float
     """Region where the gridded field ``z`` is >= ``level``, holes included."""
     gen = _generator(xs_m, ys_m, z, fill_type=contourpy.FillType.OuterOffset)
     upper = max(float(np.nanmax(z)), level) + 1.0
-    points_list, offsets_list = gen.filled(level, upper)
+    # FillType.OuterOffset: a list of point arrays and a list of offset arrays
+    points_list, offsets_list = cast(tuple[list[np.ndarray], list[np.ndarray]],
+                                     gen.filled(level, upper))
     polys: list[Polygon] = []
     for pts, offs in zip(points_list, offsets_list, strict=True):
         rings = [pts[offs[i] : offs[i + 1]] for i in range(len(offs) - 1)]

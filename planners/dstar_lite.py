@@ -17,7 +17,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from planners.geometry import Vec3, World
+from planners.geometry import Vec3, World, as_vec3
 from planners.grid import DIRECTIONS, Grid, GridParams
 from planners.kinematic import KinematicParams, KinematicSim
 from planners.result import PlanResult, PlanStatus
@@ -203,7 +203,7 @@ def run_dstar_lite(
     grid = Grid(world, start_n, grid_params)
     start, goal = grid.nearest(start_n), grid.nearest(goal_n)
     if start is None or goal is None or not grid.is_free(start):
-        return PlanResult("D* Lite", PlanStatus.START_BLOCKED, (tuple(start_n),), 0, 0, (),
+        return PlanResult("D* Lite", PlanStatus.START_BLOCKED, (as_vec3(start_n),), 0, 0, (),
                           world.clearance(start_n), 0,
                           "start is within the body radius of an obstacle or wall")
     sim = KinematicSim(world, grid.point(start),

@@ -25,6 +25,11 @@ def _vec(v: tuple[float, ...] | list[float]) -> Vec3:
     return (x, y, z)
 
 
+def as_vec3(p: Vec3 | list[float]) -> Vec3:
+    """A point as a plain tuple of floats, whatever sequence the caller passed."""
+    return (float(p[0]), float(p[1]), float(p[2]))
+
+
 def distance(a: Vec3, b: Vec3) -> float:
     """Euclidean distance between two points (m)."""
     return math.dist(a, b)

@@ -56,9 +56,10 @@ def lattice_points(lattice: Lattice, spacing_m: float, radius_m: float) -> np.nd
     if spacing_m <= 0.0 or radius_m <= 0.0:
         raise ValueError("spacing_m and radius_m must be positive")
     n = math.ceil(radius_m / spacing_m) + 2
-    i, j = np.meshgrid(np.arange(-2 * n, 2 * n + 1), np.arange(-2 * n, 2 * n + 1), indexing="ij")
-    i = i.ravel().astype(float)
-    j = j.ravel().astype(float)
+    ii, jj = np.meshgrid(np.arange(-2 * n, 2 * n + 1), np.arange(-2 * n, 2 * n + 1),
+                         indexing="ij")
+    i = ii.ravel().astype(float)
+    j = jj.ravel().astype(float)
     if lattice is Lattice.SQUARE:
         pts = np.column_stack([i, j])
     elif lattice is Lattice.TRIANGLE:
@@ -69,7 +70,7 @@ def lattice_points(lattice: Lattice, spacing_m: float, radius_m: float) -> np.nd
         a2 = np.array([math.sqrt(3.0) / 2.0, 1.5])
         base = np.outer(i, a1) + np.outer(j, a2)
         pts = np.vstack([base, base + np.array([0.0, 1.0])])
-    pts = pts * spacing_m
+    pts = np.asarray(pts, dtype=float) * spacing_m
     keep = np.hypot(pts[:, 0], pts[:, 1]) <= radius_m
     return pts[keep]
 

@@ -147,9 +147,9 @@ class ReynoldsPlanner:
             goal = to_goal / dist if dist > 1e-9 else np.zeros(3)
             obs = np.zeros(3)
             for facing in Facing:
-                r = readings[v].get(facing)
-                if r is not None and r < prm.sensing_range_m:
-                    push = (prm.sensing_range_m - r) / prm.sensing_range_m
+                seen_m = readings[v].get(facing)
+                if seen_m is not None and seen_m < prm.sensing_range_m:
+                    push = (prm.sensing_range_m - seen_m) / prm.sensing_range_m
                     obs -= np.asarray(AXIS_B[facing]) * push
             steer = (
                 prm.w_separation * sep
