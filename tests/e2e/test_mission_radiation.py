@@ -11,6 +11,9 @@ from pathlib import Path
 import pytest
 
 from gcs.mission import recording as topics
+from gcs.mission.map_file import read_map, score_map
+from gcs.mission.planner_params import planner_setup
+from gcs.mission.spec import load_mission
 from gcs.mission.world import load_world
 from logs import open_recording
 
@@ -86,3 +89,34 @@ def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
     poses = [m for _, _, m in rec.messages([topics.POSE])]
     assert len(poses) == len(samples)
     assert all(0.85 < -p["pose"]["position"]["z"] < 1.15 for p in poses), poses
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(480)
+def test_without_the_truth_the_sitl_flight_maps_unscored_and_its_map_scores_afterwards(
+        tmp_path: Path) -> None:
+    # the whole mapping flight (about 580 s of flight) at 2x: the SITL simulates the sources,
+    # the station and the mapper never hear where they are. (At 4x the SITL's telemetry came
+    # in bursts, and once the altitude estimate ran off during one.)
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "mission", "run",
+         str(ROOT / "missions" / "radiation_3src.toml"), "--speedup", "2", "--seed", "3",
+         "--no-truth", "--json", "-o", str(tmp_path)],
+        capture_output=True, text=True, timeout=450, check=False)
+    out = proc.stdout.strip().splitlines()
+    assert out, f"exit {proc.returncode}: {proc.stderr.strip()}"
+    d = json.loads(out[-1])
+    assert proc.returncode == 0, d
+    assert d["status"] == "unscored" and d["score_source"] == "none" and d["iou"] is None
+    assert d["collision_source"] == "none" and d["mode"] == "vehicle"
+    rec = open_recording(d["recording"])
+    assert rec.counts[topics.SAMPLE_RADIATION] == d["samples"]
+    contour = next(m for _, _, m in rec.messages([topics.CONTOUR]))
+    assert "sources" not in contour
+    # afterwards, by whoever knows the floor: the map file alone against the world's sources
+    m = read_map(Path(d["map"]))
+    spec = load_mission(ROOT / "missions" / "radiation_3src.toml")
+    world = load_world(spec.world_path)
+    setup = planner_setup(spec, world.world.room.min_n[:2], world.world.room.max_n[:2])
+    ev = score_map(m, world.radiation_field(height_m=spec.takeoff_alt_m), setup.params)
+    assert ev.iou >= 0.9 and ev.enclosed == 3
