@@ -24,6 +24,8 @@ class MissionEvent(enum.Enum):
     TAKING_OFF = "taking_off"
     AIRBORNE = "airborne"  # every vehicle at its hover point: the planner starts
     SAMPLE_DROPPED = "sample_dropped"  # a reading taken off mission (the autopilot took over)
+    OFF_MISSION = "off_mission"  # the link or the autopilot took a vehicle: the mission stops
+    LEFT_TO_ITSELF = "left_to_itself"  # not landed by the station: its LAND or failsafe does
     LANDING = "landing"
     LANDED = "landed"  # on the floor and disarmed
 

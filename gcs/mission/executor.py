@@ -22,6 +22,7 @@ from typing import Any
 
 from gcs.mission.craft import Craft, CraftPhase
 from gcs.mission.events import EventLog, MissionEvent
+from gcs.mission.off_mission import off_mission
 from gcs.mission.options import RunOptions
 from gcs.mission.planner_params import PlannerSetup
 from gcs.mission.plot import write_radiation_products
@@ -31,7 +32,7 @@ from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.team import Team
 from gcs.mission.truth_check import check_contacts
 from gcs.mission.vehicle_planners import fly_epbha, fly_flock, path_length_m
-from gcs.mission.vehicle_radiation import fly_radiation, off_mission
+from gcs.mission.vehicle_radiation import fly_radiation
 from gcs.mission.world import MissionWorld
 from gcs.session import SessionOptions, StationSession
 

@@ -18,6 +18,7 @@ from firmware_link.records import FlightMode
 from gcs.errors import RuntimeFault
 from gcs.mission.craft import Craft, CraftPhase, go_to_all
 from gcs.mission.events import EventLog, MissionEvent
+from gcs.mission.off_mission import off_mission
 from gcs.mission.recording import MissionRecording
 from gcs.mission.spec import MissionSpec
 from gcs.station import StationSnapshot
@@ -53,6 +54,7 @@ class Team:
         self.t_start = self.clock.now_s()
         self.min_separation_m = math.inf
         self.armed_at_s: dict[int, float] = {}
+        self.gone: dict[int, str] = {}  # vehicles the station no longer flies, and why
 
     def event(self, what: MissionEvent, vehicle: int | None = None, detail: str = "") -> None:
         """Tell the pilot and the recording."""
@@ -189,6 +191,21 @@ class Team:
         return hover
 
     # ------------------------------------------------------------------ flying
+    def check(self) -> dict[int, str]:
+        """Vehicles newly off the mission (link lost, disarmed, a mode nobody asked for), why.
+
+        Each is said once; every other vehicle flies on until the planner's loop stops.
+        """
+        new: dict[int, str] = {}
+        for v, c in self.crafts.items():
+            if v in self.gone:
+                continue
+            why = off_mission(c.snapshot(), self.elapsed_s())
+            if why is not None:
+                new[v] = self.gone[v] = why
+                self.event(MissionEvent.OFF_MISSION, v, why)
+        return new
+
     def go(self, targets: dict[int, Vec3], timeout_s: float | None = None) -> dict[int, Vec3]:
         """Fly to the targets; what the planner should take as each vehicle's position."""
         settled = go_to_all(self.crafts, targets, self.spec.position_tolerance_m,
@@ -204,9 +221,16 @@ class Team:
 
     # ------------------------------------------------------------------ landing
     def land(self) -> None:
-        """Land every vehicle, one after the other, where it is (see `_land_one`)."""
+        """Land every vehicle the station still flies, one after the other, where it is (see
+        `_land_one`). One off the mission is left to what took it: the supervisor has
+        commanded LAND on a lost link and goes silent so that the firmware's failsafe lands
+        it; a LAND or a disarm of the autopilot's own stands."""
+        self.check()
         for v, c in self.crafts.items():
             c.phase = CraftPhase.LAND
+            if v in self.gone:
+                self.event(MissionEvent.LEFT_TO_ITSELF, v, self.gone[v])
+                continue
             self.event(MissionEvent.LANDING, v)
             self._land_one(c)
             self.event(MissionEvent.LANDED, v)

@@ -32,6 +32,10 @@ class Outcome:
     products: Any = None
 
 
+def _why(gone: dict[int, str]) -> str:
+    return "; ".join(f"vehicle {v}: {why}" for v, why in sorted(gone.items()))
+
+
 def path_length_m(path: list[Vec3]) -> float:
     """Length of a polyline in metres."""
     return sum(math.dist(a, b) for a, b in itertools.pairwise(path))
@@ -68,6 +72,9 @@ def fly_epbha(f: Team, setup: PlannerSetup, hover: dict[int, Vec3]) -> Outcome:
                                       "goal_error_m": err})
         if decision.status is Status.DEADLOCK:
             return Outcome(MissionStatus.FAILED, decision.reason.value, k, path,
+                            {"cost_evaluations": planner.cost_evaluations})
+        if gone := f.check():
+            return Outcome(MissionStatus.FAILED, _why(gone), k, path,
                             {"cost_evaluations": planner.cost_evaluations})
         if f.over_budget():
             break
@@ -117,6 +124,11 @@ def fly_flock(f: Team, setup: PlannerSetup, hover: dict[int, Vec3]) -> Outcome:
             return Outcome(MissionStatus.REACHED, "every vehicle reached its goal", k,
                             paths[ids[0]], flock_metrics(f, (messages, reads), err_sq,
                                                           err_n, time_to_goal, paths))
+        if gone := f.check():
+            # the planner would go on planning round a teammate that no longer follows it
+            return Outcome(MissionStatus.FAILED, _why(gone), k, paths[ids[0]],
+                            flock_metrics(f, (messages, reads), err_sq, err_n, time_to_goal,
+                                          paths))
         if f.over_budget():
             break
         pos = f.go(dict(out.setpoints_n))

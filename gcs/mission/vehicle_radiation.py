@@ -10,16 +10,15 @@ import math
 
 import numpy as np
 
-from firmware_link.records import Battery, FlightMode, StatusText
 from gcs.mission.craft import Craft
 from gcs.mission.events import MissionEvent
+from gcs.mission.off_mission import off_mission
 from gcs.mission.planner_params import PlannerSetup
 from gcs.mission.radiation_maps import finish_radiation, is_reached
 from gcs.mission.recording import SAMPLE_RADIATION, radiation_payload
 from gcs.mission.report import MissionStatus
 from gcs.mission.team import Team
 from gcs.mission.vehicle_planners import Outcome
-from gcs.station import StationSnapshot
 from planners.geometry import Vec3
 from planners.radiation import RadiationMapper, RadiationMapperParams
 from planners.radiation_field import RadiationField
@@ -35,34 +34,6 @@ SAMPLE_STILL_MPS = 0.3
 SAMPLE_REACH_FRACTION = 0.6
 SAMPLE_SPEED_WINDOW_S = 0.25
 SAMPLE_POLL_S = 0.05  # station time: the same sampling however fast the SITL runs
-
-
-def off_mission(snap: StationSnapshot, t_airborne_s: float) -> str | None:
-    """Why a vehicle flying a mission in STABILIZE no longer is (None while it still is).
-
-    An autopilot failsafe (battery, GCS) switches to LAND by itself: the mission must stop
-    there, or it records readings taken on the floor as if they were flown.
-    """
-    if snap.link_lost:
-        why = "link lost"
-    elif not snap.armed:
-        why = "disarmed"
-    elif snap.vehicle_mode >= 0 and snap.vehicle_mode != FlightMode.STABILIZE:
-        try:
-            why = f"switched to {FlightMode(snap.vehicle_mode).name}"
-        except ValueError:
-            why = f"switched to mode {snap.vehicle_mode}"
-    else:
-        return None
-    details = [f"after {t_airborne_s:.0f} s of flight"]
-    batt = snap.latest.get(Battery)
-    if isinstance(batt, Battery):
-        details.append(f"battery {batt.voltage_v:.2f} V"
-                       + (f" {batt.remaining_pct} %" if batt.remaining_pct >= 0 else ""))
-    text = snap.latest.get(StatusText)
-    if isinstance(text, StatusText) and "failsafe" in text.text.lower():
-        details.append(f"vehicle said '{text.text}'")
-    return f"vehicle {why} ({', '.join(details)})"
 
 
 def _hold_for_sample(f: Team, craft: Craft, target: Vec3, leg_m: float,

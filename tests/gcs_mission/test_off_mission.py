@@ -4,7 +4,7 @@ from types import SimpleNamespace
 from typing import Any
 
 from firmware_link.records import Battery, FlightMode, StatusText
-from gcs.mission.vehicle_radiation import off_mission
+from gcs.mission.off_mission import off_mission
 
 
 def _snap(mode: int = FlightMode.STABILIZE, armed: bool = True, link_lost: bool = False,

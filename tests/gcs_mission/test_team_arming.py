@@ -116,3 +116,43 @@ def test_the_shortest_auto_disarm_of_the_team_sets_the_budget() -> None:
     with pytest.raises(RuntimeFault, match="within 5 s"):
         t.arm()
     assert all(s.disarm_asked for s in stations)
+
+
+@dataclass(frozen=True)
+class _Flying:
+    """Only what `off_mission` reads of a snapshot."""
+
+    vehicle_mode: int = int(FlightMode.STABILIZE)
+    armed: bool = True
+    link_lost: bool = False
+    latest: dict = field(default_factory=dict)
+
+
+class _Aloft:
+    def __init__(self, sysid: int, station: FakeStation) -> None:
+        self.sysid = sysid
+        self.station = station
+        self.snap = _Flying()
+
+    def snapshot(self) -> Any:
+        return self.snap
+
+
+def test_a_vehicle_the_link_lost_stops_the_mission_and_is_left_to_its_failsafe(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    clock = SimClock(100.0)
+    crafts = {v: _Aloft(v, FakeStation(clock, 0.5)) for v in (1, 2, 3)}
+    events = EventLog(None, None)
+    t = Team(load_mission(MISSION), crafts, None, events)  # type: ignore[arg-type]
+    landed: list[int] = []
+    monkeypatch.setattr(t, "_land_one", lambda c: landed.append(c.sysid))
+    assert t.check() == {}
+    crafts[2].snap = _Flying(link_lost=True)
+    gone = t.check()
+    assert list(gone) == [2] and gone[2].startswith("vehicle link lost")
+    assert t.check() == {}  # said once
+    t.land()
+    assert landed == [1, 3]  # the station lands what it still flies, nothing waits on 2
+    kinds = [(e, v) for _, e, v, _ in events.seen]
+    assert (MissionEvent.OFF_MISSION, 2) in kinds and (MissionEvent.LEFT_TO_ITSELF, 2) in kinds
+    assert kinds.count((MissionEvent.LANDED, 1)) == kinds.count((MissionEvent.LANDED, 3)) == 1
