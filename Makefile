@@ -18,7 +18,7 @@ run: $(STAMP)
 # One BLAS thread: on two cores numpy's threaded linear algebra fights the test processes.
 test: $(STAMP)
 	$(BIN)/ruff check .
-	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q --durations=25
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
