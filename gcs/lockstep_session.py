@@ -15,6 +15,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+import numpy as np
+
 from firmware_link.truth_link import TruthLink
 from gcs.config import StationConfig, load_config
 from gcs.errors import UsageError
@@ -25,6 +27,11 @@ LOCKSTEP_EPOCH_NS = 946_684_800 * 10**9
 """2000-01-01T00:00:00Z: where simulated time zero sits on a lockstep recording's timeline. A
 simulated flight has no date of its own, and a wall-clock anchor would make two recordings of one
 seed differ (the metadata's `started_utc` says when it was flown)."""
+
+
+CONNECT_AFTER_S = (0.2, 1.2)
+"""When the station connects, in simulated seconds after the SITL started (seeded)."""
+CONNECT_STREAM = 0x10C5  # the seed's stream for that choice, apart from the SITL's own
 
 
 class LockstepSession(StationSession):
@@ -64,6 +71,13 @@ class LockstepSession(StationSession):
         # a lockstep loop never waits: at real-time priority it would only take a core from
         # every other process on the machine (and a Ray worker would keep it for later tasks)
         config = dataclasses.replace(config, realtime_priority=0)
+        # Over TCP the station comes to a SITL that has run for a while, so its ticks, the
+        # SITL's and the SITL's sonar pings meet at a phase the moment decides; a lockstep
+        # station connecting at a fixed simulated time would meet them at one phase for every
+        # seed (which readings look repeated, say), a bias no seed averages out. The seed
+        # chooses the moment instead.
+        rng = np.random.default_rng([self.options.seed or 0, CONNECT_STREAM])
+        self.sitl.sitl.advance_to(float(rng.uniform(*CONNECT_AFTER_S)))
         for sysid in self.options.sysids:
             self.vehicles[sysid] = self._open_vehicle(sysid, self.sitl.url(sysid),
                                                       self.sitl.mocap, None, config)
