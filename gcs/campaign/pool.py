@@ -12,6 +12,7 @@ returns the rows that had.
 
 from __future__ import annotations
 
+import importlib
 import logging
 import os
 import socket
@@ -25,6 +26,15 @@ from gcs.errors import RuntimeFault, UsageError
 
 ADDRESS_ENV = "RAY_ADDRESS"
 CONNECT_TIMEOUT_S = 3.0
+
+
+def need(module: str) -> Any:
+    """A campaign dependency, or one line saying how to install it."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise UsageError(f"quadgcs campaign needs {module}: pip install 'quadgcs[campaign]' "
+                         "(make installs it)") from None
 
 
 def _check_reachable(address: str) -> None:
@@ -46,7 +56,7 @@ def _check_reachable(address: str) -> None:
 @contextmanager
 def ray_session(address: str | None, num_cpus: int | None) -> Iterator[Any]:
     """Ray, started locally or joined at `address` (else RAY_ADDRESS); shut down after."""
-    import ray
+    ray = need("ray")
 
     address = address or os.environ.get(ADDRESS_ENV) or None
     quiet: dict[str, Any] = {"log_to_driver": False, "logging_level": logging.ERROR}

@@ -19,7 +19,7 @@ from typing import Any
 from gcs.campaign.driver import Outcome, RowKeeper
 from gcs.campaign.metrics import OK
 from gcs.campaign.plots import history_plot
-from gcs.campaign.pool import run_all
+from gcs.campaign.pool import need, run_all
 from gcs.campaign.progress import Progress
 from gcs.campaign.results import RESULTS_NAME, read_results
 from gcs.campaign.run import RunSpec, fly_run, make_run
@@ -85,7 +85,7 @@ def objective(c: Campaign, rows: list[dict[str, Any]]) -> float:
 def run_search(c: Campaign, out_dir: Path, ray: Any, csv: bool = False, quiet: bool = False,
                runner: Callable[..., dict[str, Any]] = fly_run) -> SearchOutcome:
     """Run the search's trials (those not already in the results) and write the best."""
-    import optuna
+    optuna = need("optuna")
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     dists = _distributions(c)

@@ -50,8 +50,10 @@ def run(args: argparse.Namespace) -> int:
         summary_table,
     )
     from gcs.campaign.plots import axis_plots
+    from gcs.campaign.pool import need
 
     c = load_campaign(args.file)
+    need("pyarrow")  # the results file: before any run, not after the first
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers}: expected at least 1")
     out_dir = args.output or DEFAULT_OUTPUT / c.name

@@ -11,6 +11,10 @@ from typing import Any
 
 import pytest
 
+pytest.importorskip("ray")
+pytest.importorskip("optuna")
+pytest.importorskip("pyarrow")
+
 from gcs.campaign import (
     BEST_NAME,
     load_campaign,
