@@ -320,3 +320,21 @@ def test_barometer_bridges_a_sonar_gap_and_stays_out_of_the_way_otherwise() -> N
     # with the barometer's offset learned, about half that
     assert np.mean(gap_rms_baro) < 0.6 * np.mean(gap_rms)
     assert max(gap_rms_baro) < 0.6 * max(gap_rms)
+
+
+def test_a_telemetry_gap_is_bridged_with_no_acceleration_not_the_last_sample() -> None:
+    """Nothing arrives for 0.5 s (a stalled link, a starved loop) right after an IMU sample
+    0.8 m/s² off: integrating that one sample for the whole gap would move the estimate 10 cm
+    and leave 0.4 m/s of velocity for the PID's D term to act on."""
+    est = KalmanEstimator()
+    fly(est, hover(1.0), 10.0, acc_noise=0.0)
+    t = 10.0
+    bump = body_specific_force(0.15 + 0.8, 0.0, 0.0)  # bias plus a vibration spike
+    att = Attitude(t, 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    est.update(Imu(t_s=t, sysid=1, acc_b=bump, gyro_b=(0, 0, 0), source="RAW_IMU"), None, att, t)
+    r = None
+    for k in range(1, 21):  # 0.5 s of ticks with nothing new
+        r = est.update(None, None, None, t + k * DT)
+    assert r is not None
+    assert abs(r.alt_m - 1.0) < 0.03, r
+    assert abs(r.vel_mps) < 0.1, r
