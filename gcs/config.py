@@ -17,7 +17,6 @@ from __future__ import annotations
 import dataclasses
 import enum
 import math
-import tomllib
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +26,7 @@ from gcs.altitude_controller import AltitudeControllerParams
 from gcs.errors import UsageError
 from gcs.estimation import EstimatorParams
 from gcs.position_controller import PositionControllerParams
+from gcs.toml_file import read_toml
 
 
 class EstimatorKind(enum.Enum):
@@ -123,14 +123,7 @@ def load_config(path: str | Path | None) -> StationConfig:
     if path is None:
         return StationConfig()
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise UsageError(f"{p}: no such config file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UsageError(f"{p}: cannot read config file ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UsageError(f"{p}: not valid TOML ({exc})") from None
+    data = read_toml(p, label=str(p), noun="config file")
     return _build(StationConfig(), data, f"{p}: ")
 
 

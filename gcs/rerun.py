@@ -36,6 +36,7 @@ from gcs.position_controller import PositionController
 from gcs.station import StationSetup, TickInputs, average_imu
 from gcs.supervisor import Intent, Supervisor, SupervisorParams, TickIn, VehicleStatus
 from gcs.thrust_curve import ThrottleCurve
+from gcs.toml_file import read_toml
 from logs import Recording, RecordingError, from_jsonable
 
 GAIN_ALIASES: dict[str, str] = {
@@ -307,14 +308,7 @@ def parse_gains(spec: str) -> dict[str, Any]:
     or their short forms (`alt.kp`, `est.sonar_sigma_m`, `pos.…`); values are TOML values."""
     path = Path(spec)
     if spec.endswith(".toml") or path.is_file():
-        try:
-            return tomllib.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise UsageError(f"--gains {spec}: no such file") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise UsageError(f"--gains {spec}: cannot read ({exc})") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise UsageError(f"--gains {spec}: not valid TOML ({exc})") from None
+        return read_toml(path, label=f"--gains {spec}")
     table: dict[str, Any] = {}
     for item in filter(None, (s.strip() for s in spec.split(","))):
         key, eq, text = item.partition("=")

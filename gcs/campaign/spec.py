@@ -50,6 +50,7 @@ from gcs.campaign.tables import check_faults, check_world, set_dotted, world_tab
 from gcs.config import config_from_table
 from gcs.errors import UsageError
 from gcs.flight import FlightPlan
+from gcs.toml_file import read_toml
 
 KINDS = ("grid", "random", "search")
 TOP_KEYS = {"name", "kind", "samples", "sample_seed", "fly", "mission", "axes", "search"}
@@ -154,14 +155,7 @@ def _rel(path: Path, key: str, text: Any, what: str) -> Path:
 def load_campaign(path: str | Path) -> Campaign:
     """Read and check a campaign file; CampaignError (one line) for any problem."""
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise CampaignError(f"{p}: no such campaign file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CampaignError(f"{p}: cannot read ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignError(f"{p}: not valid TOML ({exc})") from None
+    data = read_toml(p, label=str(p), noun="campaign file", error=CampaignError)
     for key in data:
         if key not in TOP_KEYS:
             raise _fail(p, key, f"unknown key; expected one of {sorted(TOP_KEYS)}")
