@@ -14,6 +14,7 @@ The station still learns everything from MAVLink bytes: the SITL's ports are plu
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import itertools
 from dataclasses import dataclass
@@ -85,8 +86,11 @@ class BundledLockstep:
         self._names: list[str] = []
         self.ports = {s: self.sitl.vehicle_port(s, faults) for s in range(1, options.vehicles + 1)}
         self.vehicles = {s: self._plug(f"vehicle{s}", p) for s, p in self.ports.items()}
-        self.mocap = (self._plug("mocap", self.sitl.mocap_port())
-                      if self.sitl.mocap_enabled else None)
+        # one motion-capture client per vehicle, as over TCP: readers of one pipe would share
+        # out its bytes between them
+        self.mocaps = ({s: self._plug(f"mocap{s}", self.sitl.mocap_port()) for s in self.ports}
+                       if self.sitl.mocap_enabled else {})
+        self.mocap = self.mocaps.get(1)
         self.truth = self._plug("truth", self.sitl.truth_port()) if options.truth else None
 
     def _plug(self, what: str, port: Any) -> str:
@@ -126,3 +130,58 @@ class SteppedTruth:
     def close(self) -> None:
         """Close the link. Idempotent."""
         self.link.close()
+
+
+class SteppedLoop(Protocol):
+    @property
+    def next_deadline_s(self) -> float | None: ...
+
+
+class SteppedStation(Protocol):
+    """What `TeamClock` needs of a station run by `run_tick` (`gcs.station.Station`)."""
+
+    @property
+    def loop(self) -> SteppedLoop: ...
+
+    @property
+    def error(self) -> BaseException | None: ...
+
+    def run_tick(self) -> None: ...
+
+
+class TeamClock:
+    """The clock a mission waits on when its vehicles' stations run in lockstep.
+
+    Over TCP every station has a loop thread and the mission's waits are plain sleeps. Here a
+    wait runs the stations' ticks due before its end, earliest first, so the shared simulation
+    only ever moves forward and every vehicle is flown while the mission looks elsewhere (one
+    vehicle landing while the others hold). A station whose tick raised is left out from then
+    on, as its loop thread would have died: the mission sees the error on its next look.
+    """
+
+    def __init__(self, timeline: Timeline, stations: list[SteppedStation]) -> None:
+        self.timeline = timeline
+        self.stations = stations
+
+    def now_s(self) -> float:
+        """The simulated time."""
+        return self.timeline.t_s
+
+    def sleep_until(self, t_s: float) -> None:
+        """Tick every station due before `t_s`, then run the simulation up to `t_s`."""
+        live = [s for s in self.stations if s.error is None]
+        while live:
+            due = min(live, key=self._due_s)
+            was = self._due_s(due)
+            if was > t_s:
+                break
+            # the error is kept by the station (its snapshot raises); the mission decides
+            with contextlib.suppress(Exception):
+                due.run_tick()
+            if due.error is not None or self._due_s(due) <= was:
+                live.remove(due)  # crashed, or a stopped loop that no longer ticks
+        self.timeline.advance_to(t_s)
+
+    def _due_s(self, station: SteppedStation) -> float:
+        t = station.loop.next_deadline_s
+        return self.timeline.t_s if t is None else t

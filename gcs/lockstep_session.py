@@ -20,8 +20,9 @@ import numpy as np
 from firmware_link.truth_link import TruthLink
 from gcs.config import StationConfig, load_config
 from gcs.errors import UsageError
-from gcs.lockstep import BundledLockstep, LockstepOptions, SteppedTruth
+from gcs.lockstep import BundledLockstep, LockstepOptions, SteppedTruth, TeamClock
 from gcs.session import SCORED_COMMANDS, SessionOptions, StationSession
+from gcs.station import LAND_UNTIL, LAND_WAIT_STATES
 
 LOCKSTEP_EPOCH_NS = 946_684_800 * 10**9
 """2000-01-01T00:00:00Z: where simulated time zero sits on a lockstep recording's timeline. A
@@ -32,6 +33,7 @@ seed differ (the metadata's `started_utc` says when it was flown)."""
 CONNECT_AFTER_S = (0.2, 1.2)
 """When the station connects, in simulated seconds after the SITL started (seeded)."""
 CONNECT_STREAM = 0x10C5  # the seed's stream for that choice, apart from the SITL's own
+POLL_S = 0.1
 
 
 class LockstepSession(StationSession):
@@ -80,7 +82,9 @@ class LockstepSession(StationSession):
         self.sitl.sitl.advance_to(float(rng.uniform(*CONNECT_AFTER_S)))
         for sysid in self.options.sysids:
             self.vehicles[sysid] = self._open_vehicle(sysid, self.sitl.url(sysid),
-                                                      self.sitl.mocap, None, config)
+                                                      self.sitl.mocaps.get(sysid), None, config)
+        # registered after every station's stop, so it runs first: a team lands together
+        self._stack.callback(self._land_together)
         if self.sitl.truth is not None:
             for sysid, v in self.vehicles.items():
                 truth = SteppedTruth(TruthLink.open(self.sitl.truth, clock=self.clock.now_s),
@@ -88,6 +92,33 @@ class LockstepSession(StationSession):
                 self._stack.callback(truth.close)
                 v.station.add_listener(truth.pump)
                 v.truth = truth  # type: ignore[assignment]
+
+    def team_clock(self) -> TeamClock:
+        """The clock a mission waits on: each wait flies every vehicle's station."""
+        return TeamClock(self.sitl.sitl, [v.station for v in self.vehicles.values()])
+
+    def _land_together(self) -> None:
+        """Leaving with vehicles that may fly: ask all to land, and fly all while they do.
+
+        Each station's own stop lands its vehicle on its own ticks; one after the other, the
+        vehicles waiting their turn would get no overrides for seconds."""
+        flying = [v.station for v in self.vehicles.values()
+                  if v.station.error is None
+                  and v.station.snapshot(loop_stats=False).state in LAND_UNTIL]
+        if len(flying) < 2:
+            return
+        clock = TeamClock(self.sitl.sitl, list(flying))
+        deadline = clock.now_s() + max(st.supervisor_params.quit_timeout_s for st in flying)
+        next_ask = clock.now_s()
+        while clock.now_s() < deadline:
+            if clock.now_s() >= next_ask:  # asked again each second, as a stop does
+                for st in flying:
+                    st.quit()
+                next_ask += 1.0
+            clock.sleep_until(clock.now_s() + POLL_S)
+            if all(st.error is not None
+                   or st.snapshot(loop_stats=False).state in LAND_WAIT_STATES for st in flying):
+                return
 
     def tick(self) -> None:
         """One tick of every vehicle's station (the simulation runs up to each deadline)."""

@@ -107,6 +107,11 @@ class FixedRateLoop:
         return self._stop.is_set()
 
     @property
+    def next_deadline_s(self) -> float | None:
+        """When the next tick is due (None before the first `run`)."""
+        return None if self._t0_s is None else self._t0_s + self._k * self.period_s
+
+    @property
     def last_timing(self) -> TickTiming | None:
         """The most recent tick's timing."""
         return self._last

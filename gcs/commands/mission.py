@@ -35,6 +35,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--speedup", type=float,
                    help="run the bundled SITL and the station's clock this many times faster "
                         "(default: the mission file's flight.speedup)")
+    r.add_argument("--lockstep", action="store_true",
+                   help="fly the bundled SITL in this process on simulated time: as fast as "
+                        "the machine computes, the same mission for the same seed")
     r.add_argument("--seed", type=int, help="seed of the noise (kinematic world or SITL)")
     r.add_argument("--record", action=argparse.BooleanOptionalAction, default=True,
                    help="record to MCAP (default on)")
@@ -67,8 +70,12 @@ def _progress(line: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """CLI entry: load, run, print; MissionFailed (exit 3) after printing when not reached."""
-    if args.kinematic and (args.connect or args.mocap or args.forward):
-        raise UsageError("--kinematic flies no vehicle: drop --connect/--mocap/--forward")
+    if args.kinematic and (args.connect or args.mocap or args.forward or args.lockstep):
+        raise UsageError("--kinematic flies no vehicle: drop --connect/--mocap/--forward/"
+                         "--lockstep")
+    if args.lockstep and args.speedup is not None:
+        raise UsageError("--lockstep: --speedup cannot be used with it (lockstep flies the "
+                         "bundled SITL in this process on simulated time)")
     if args.speedup is not None and not 0 < args.speedup <= 50:
         raise UsageError(f"--speedup {args.speedup}: expected 0 < speedup <= 50")
     spec = load_mission(args.file)
@@ -76,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
                          record=args.record, output=args.output, plot=args.plot,
                          speedup=args.speedup, seed=args.seed, fix_failsafe=args.fix_failsafe,
                          foxglove=args.foxglove, forward=tuple(args.forward),
-                         truth=args.truth)
+                         truth=args.truth, lockstep=args.lockstep)
     report = run_mission(spec, options, None if (args.quiet or args.json) else _progress)
     if args.json:
         print(report.to_json(), flush=True)

@@ -12,11 +12,11 @@ from __future__ import annotations
 import enum
 import math
 import threading
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from firmware_link.records import MocapPose, Proximity, Radiation, SimTruth
+from gcs.clock import Clock
 from gcs.errors import RuntimeFault
 from gcs.position_controller import PositionSetpoint
 from gcs.station import Station, StationSnapshot
@@ -67,11 +67,14 @@ def yaw_of(q_nb: tuple[float, float, float, float]) -> float:
 class Craft:
     """A started station plus the mission's view of its vehicle."""
 
-    def __init__(self, sysid: int, station: Station, truth: bool = True) -> None:
+    def __init__(self, sysid: int, station: Station, truth: bool = True,
+                 clock: Clock | None = None) -> None:
         """The mission's view of `station`'s vehicle; `truth` False: the SITL's ground truth
-        (SIM_STATE), should the vehicle send it, is not kept (`--no-truth`)."""
+        (SIM_STATE), should the vehicle send it, is not kept (`--no-truth`). `clock`: what the
+        mission waits on (default the station's; in lockstep one that runs the stations)."""
         self.sysid = sysid
         self.station = station
+        self.clock: Clock = station.clock if clock is None else clock
         self.keeps_truth = truth
         self.phase = CraftPhase.GROUND
         self._lock = threading.Lock()
@@ -158,12 +161,12 @@ class Craft:
 
     def wait(self, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> bool:
         """Poll snapshots until `pred` holds (True) or `timeout_s` of station clock (False)."""
-        clock = self.station.clock
+        clock = self.clock
         deadline = clock.now_s() + timeout_s
         while clock.now_s() < deadline:
             if pred(self.snapshot()):
                 return True
-            time.sleep(POLL_S)
+            clock.sleep_until(min(clock.now_s() + POLL_S, deadline))
         return False
 
     def refresh(self) -> None:
@@ -212,7 +215,7 @@ def go_to_all(crafts: dict[int, Craft], targets_n: dict[int, Vec3], tolerance_m:
     """
     for v, target in targets_n.items():
         crafts[v].command(target)
-    clock = next(iter(crafts.values())).station.clock
+    clock = next(iter(crafts.values())).clock
     start = clock.now_s()
     inside_since: dict[int, float | None] = dict.fromkeys(targets_n)
     settled = dict.fromkeys(targets_n, False)
@@ -234,4 +237,4 @@ def go_to_all(crafts: dict[int, Craft], targets_n: dict[int, Vec3], tolerance_m:
             return settled
         if tick is not None:
             tick()
-        time.sleep(POLL_S)
+        clock.sleep_until(clock.now_s() + POLL_S)

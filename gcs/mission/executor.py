@@ -18,7 +18,7 @@ import dataclasses
 import math
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from gcs.mission.craft import Craft, CraftPhase
 from gcs.mission.events import EventLog, MissionEvent
@@ -36,6 +36,9 @@ from gcs.mission.vehicle_radiation import fly_radiation
 from gcs.mission.world import MissionWorld
 from gcs.session import SessionOptions, StationSession
 
+if TYPE_CHECKING:
+    from gcs.lockstep_session import LockstepSession
+
 __all__ = ["off_mission", "run_on_vehicles"]
 
 Progress = Callable[[str], None]
@@ -46,6 +49,8 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
     """Fly the mission with one station per vehicle; the report (with truth-based collisions)."""
     wall0 = time.monotonic()
     speedup = options.speedup if options.speedup is not None else spec.speedup
+    if options.lockstep:
+        speedup = 1.0  # simulated time: as fast as the machine computes it, no wall clock
     sysids = tuple(v.sysid for v in spec.vehicles)
     session_options = SessionOptions(
         command="mission", connect=options.connect, mocap=options.mocap, profile=spec.profile,
@@ -61,12 +66,22 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         # else at normal priority, the bundled SITL included, whose telemetry then comes in
         # bursts. Plain sleeps overshoot by a millisecond at most, a twenty-fifth of a tick.
         session_options = dataclasses.replace(session_options, spin_s=0.0)
-    with StationSession(session_options) as session:
+    session: StationSession
+    lockstep: LockstepSession | None = None
+    if options.lockstep:
+        from gcs.lockstep_session import LockstepSession
+
+        session = lockstep = LockstepSession(session_options)
+    else:
+        session = StationSession(session_options)
+    with session:
+        clock = lockstep.team_clock() if lockstep is not None else None
         crafts: dict[int, Craft] = {}
         for sysid in sysids:
             vehicle = session.vehicles[sysid]
-            crafts[sysid] = Craft(sysid, vehicle.station, truth=options.truth)
-            vehicle.station.start()
+            crafts[sysid] = Craft(sysid, vehicle.station, truth=options.truth, clock=clock)
+            if clock is None:
+                vehicle.station.start()
         rec = _MultiRecording({s: session.vehicles[s].sink for s in sysids})
         # the room's bounds are the planner's to know; the boxes in it only with the truth
         rec.scene(time.monotonic(), mw.world.room, mw.world.obstacles if options.truth else ())
@@ -92,7 +107,8 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         status, reason = outcome.status, outcome.reason
         if collisions and status is MissionStatus.REACHED:
             status, reason = MissionStatus.FAILED, f"{reason}, but {collisions} collisions"
-        metrics = {**outcome.metrics, **truth_metrics, "speedup": speedup}
+        metrics = {**outcome.metrics, **truth_metrics, "speedup": speedup,
+                   "clock": "lockstep" if options.lockstep else "wall"}
         if len(sysids) > 1:
             metrics["recordings"] = [r.path.as_posix() for s in sysids
                                      if (r := session.vehicles[s].recorder) is not None]

@@ -24,3 +24,5 @@ class RunOptions:
     # False (--no-truth): the station and the planner never see the world's sources or boxes
     # (the SITL or the kinematic world still simulates them) and nothing is scored against them
     truth: bool = True
+    # the bundled SITL in this process on simulated time (`mission run --lockstep`)
+    lockstep: bool = False

@@ -50,7 +50,7 @@ class Team:
         self.crafts = crafts
         self.rec = rec
         self.events = events
-        self.clock = next(iter(crafts.values())).station.clock
+        self.clock = next(iter(crafts.values())).clock
         self.t_start = self.clock.now_s()
         self.min_separation_m = math.inf
         self.armed_at_s: dict[int, float] = {}

@@ -62,6 +62,7 @@ class FakeCraft:
     def __init__(self, sysid: int, station: FakeStation) -> None:
         self.sysid = sysid
         self.station = station
+        self.clock = station.clock  # what the mission waits on
 
     def snapshot(self) -> Any:
         st = self.station
@@ -132,6 +133,7 @@ class _Aloft:
     def __init__(self, sysid: int, station: FakeStation) -> None:
         self.sysid = sysid
         self.station = station
+        self.clock = station.clock
         self.snap = _Flying()
 
     def snapshot(self) -> Any:
