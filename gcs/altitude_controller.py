@@ -113,6 +113,12 @@ class AltitudeController:
         self.pid.engage(estimate.alt_m, estimate.alt_m, a0)
         self._clamped = 0
 
+    def surface_changed(self, jump_m: float) -> None:
+        """The estimate jumped by `jump_m` because the sonar now measures from another surface
+        (a table top, the floor past its edge): the setpoint profile jumps with it, so that
+        neither the error nor the derivative steps (the caller moves the target too)."""
+        self.pid.shift_setpoint(jump_m)
+
     def hover_stick_us(self) -> int:
         """The stick PWM that holds the learned hover throttle, level."""
         p = self.params

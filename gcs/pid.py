@@ -89,6 +89,14 @@ class Pid:
         """Move the integrator by `delta` (clamped), when a learned trim takes over its share."""
         self._i = min(max(self._i + delta, -self.gains.i_max), self.gains.i_max)
 
+    def shift_setpoint(self, delta: float) -> None:
+        """Move the shaped setpoint and the derivative's last measurement by `delta`: the
+        measurement's origin moved (not the plant), so neither error nor derivative may step."""
+        if self._shaped is not None:
+            self._shaped += delta
+        if self._prev_measurement is not None:
+            self._prev_measurement += delta
+
     def reset_filter(self) -> None:
         """Forget the derivative history (the next step computes no derivative)."""
         self._d = 0.0

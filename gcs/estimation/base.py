@@ -158,6 +158,9 @@ class AltEstimator(ABC):
         self._rejected_total = 0
         self._initialised = False
         self._reject_run_start_s = 0.0
+        self._reject_seen_s = -math.inf  # last rejected reading, or a repeat of it
+        self._range_m = 0.0  # the last valid sonar range, accepted or not, and its tick
+        self._range_t_s = -math.inf
 
     @abstractmethod
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
@@ -217,8 +220,14 @@ class AltEstimator(ABC):
             status, innovation = self._sonar(sonar, t_s, alt_before)
         if at_rest and self._state()[0] < p.ground_alt_m:
             self._at_rest()
-        if baro_alt_m is not None and self._initialised and (
-                at_rest or self._state()[0] >= p.baro_min_alt_m):
+        # Downwash off the surface below biases the barometer. Which surface: the estimate's, or
+        # the one the sonar sees now even when its reading is rejected. Past a table's edge
+        # the estimate still measures from the table top until it re-bases; shutting the
+        # barometer out then would leave it to the accelerometer alone for seconds.
+        seen_clear = (t_s - self._range_t_s <= p.stale_after_s
+                      and self._range_m >= p.baro_min_alt_m)
+        clear = self._state()[0] >= p.baro_min_alt_m or seen_clear
+        if baro_alt_m is not None and self._initialised and (at_rest or clear):
             self._baro(baro_alt_m, coasting=t_s - self._last_sonar_t_s > p.stale_after_s)
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
@@ -262,6 +271,8 @@ class AltEstimator(ABC):
 
     def _sonar(self, sonar: Rangefinder, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
         d = sonar.distance_m if sonar.valid else 0.0
+        if d > self.params.sonar_min_m:
+            self._range_m, self._range_t_s = d, t_s
         # the message's own arrival (receive stamp) times the repeat test; the tick's time
         # (`t_s`) times everything the filter does with the reading
         fresh = self._is_new_reading(d, sonar.t_s)
@@ -326,6 +337,10 @@ class AltEstimator(ABC):
                 self._doubt_until_s = sonar.t_s + p.sonar_doubt_s
             return SonarStatus.INVALID, 0.0
         if not fresh:
+            if self._rejected and d == self._last_distance:
+                # the stream repeating a disagreeing reading: the disagreement goes on (with
+                # whole centimetres a steady floor past a table's edge mostly repeats)
+                self._reject_seen_s = t_s
             return SonarStatus.DUPLICATE, 0.0
         z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
         # The HC-SR04 does not ping again before an echo is back, so a reading after a long
@@ -354,11 +369,12 @@ class AltEstimator(ABC):
             self._last_sonar_t_s = t_s
             return SonarStatus.USED, innovation
         self._rejected_total += 1
-        if self._rejected and t_s - self._rejected[-1][0] > p.stale_after_s:
+        if self._rejected and t_s - self._reject_seen_s > p.stale_after_s:
             self._rejected.clear()  # not consecutive: readings were accepted or absent between
         if not self._rejected:
             self._reject_run_start_s = t_s
         self._rejected.append((t_s, z_now))
+        self._reject_seen_s = t_s
         while self._rejected[0][0] < t_s - p.reacquire_window_s:
             self._rejected.popleft()
         recent = [r for _, r in self._rejected]

@@ -22,6 +22,7 @@ import math
 
 from firmware_link.records import FlightMode, RcCommand
 from gcs.altitude_controller import AltControlOutput, AltitudeController
+from gcs.estimation import SonarStatus
 from gcs.position_controller import PositionCommand, PositionController, PositionSetpoint
 from gcs.supervisor.params import SupervisorParams
 from gcs.supervisor.types import (
@@ -91,6 +92,7 @@ class Supervisor:
         self._ramp_us = 0.0
         self._ramp_top_since_s: float | None = None
         self._frozen: RcCommand | None = None
+        self._prev_alt_m: float | None = None  # last tick's altitude estimate
         self._mocap_ok = False
         self._link = LinkHealth.OK
         self._actions: list[Action] = []
@@ -153,6 +155,7 @@ class Supervisor:
         if self._link is not LinkHealth.LOST:
             self._watch_vehicle(inp)
         command, heartbeat = self._run(inp)
+        self._prev_alt_m = inp.estimate.alt_m
         if command is not None:
             self.command = command
         return SupervisorOutput(
@@ -439,6 +442,17 @@ class Supervisor:
             self._note(Level.INFO, "telemetry back: altitude hold resumes")
         est = inp.estimate
         assert self.alt_setpoint_m is not None
+        if est.sonar_status is SonarStatus.REACQUIRED and self._prev_alt_m is not None:
+            # Not a move of the vehicle: the estimator re-based on another surface below (past
+            # a table's edge, or back from a drift). Held as it comes, the step is an error of
+            # up to a table's height: the vehicle dives for the tabletop it just left. As
+            # ArduCopter's surface tracking resets its target on a rangefinder step, the hold
+            # keeps the height it flies at, measured from the new surface.
+            jump = est.alt_m - self._prev_alt_m
+            self.alt_ctrl.surface_changed(jump)
+            self.alt_setpoint_m += jump
+            if self.alt_target_m is not None:
+                self.alt_target_m += jump
         # the controller's setpoint profile makes the move (at the asked rate, braking before
         # the target): a ramp that stops dead at the target overshoots it
         if self.alt_target_m is not None:

@@ -46,6 +46,7 @@ class Script:
         self.alt = REST_M
         self.vel = 0.0
         self.mocap: MocapPose | None = None
+        self.sonar = SonarStatus.USED  # what the estimator did with this tick's reading
         self.outs: list[SupervisorOutput] = []
 
     def tick(self, *intents: Intent) -> SupervisorOutput:
@@ -54,7 +55,7 @@ class Script:
             self.rx_t = self.t
             if self.t - self.hb_t >= 1.0:
                 self.hb_t = self.t
-        est = AltEstimate(self.t, self.alt, self.vel, 0.0, 0.0, True, SonarStatus.USED, 0.0, 0.0,
+        est = AltEstimate(self.t, self.alt, self.vel, 0.0, 0.0, True, self.sonar, 0.0, 0.0,
                           False, 0.01, 0)
         v = VehicleStatus(seen=True, armed=self.armed, mode=self.mode, heartbeat_t_s=self.hb_t,
                           frame_age_s=self.t - self.rx_t)
@@ -321,6 +322,30 @@ def test_integrator_frozen_on_the_floor_and_against_the_stick_clamp() -> None:
     if pinned:
         assert s.sup.alt_ctrl.pid.integrator <= i1 + 1e-9
     assert s.sup.alt is not None and (s.sup.alt.saturated or not pinned)
+
+
+@pytest.mark.parametrize("status", [SonarStatus.REACQUIRED, SonarStatus.USED])
+def test_an_estimate_rebased_on_another_surface_moves_no_stick(status: SonarStatus) -> None:
+    # Past a table's edge the estimator re-bases its altitude on the floor, 0.72 m further
+    # down, in one tick: the vehicle has not moved and the throttle must not change (the hold
+    # keeps its height, now over the floor). The same step reported as a plain reading is an
+    # altitude error the loop must act on.
+    s = Script()
+    s.hovering(alt_m=0.33)
+    s.run(3.0)
+    before = s.outs[-1].command
+    assert before is not None
+    s.alt, s.sonar = 0.33 + 0.72, status
+    outs = [s.tick()]
+    s.sonar = SonarStatus.USED
+    outs += s.run(1.0)
+    moves = [abs(o.command.throttle_us - before.throttle_us) for o in outs
+             if o.command is not None]
+    if status is SonarStatus.REACQUIRED:
+        assert max(moves) <= 5
+        assert s.sup.alt_setpoint_m == pytest.approx(1.05, abs=0.01)
+    else:
+        assert min(moves) >= 50
 
 
 def test_quit_while_hovering_lands_first_and_releases_after_land_is_seen() -> None:
