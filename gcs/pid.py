@@ -36,12 +36,17 @@ class PidGains:
     setpoint_accel_per_s2: float = math.inf  # max change of that rate (trapezoidal profile)
     ff_accel: float = 0.0  # feed-forward gain on the shaped setpoint's acceleration
     error_max: float = math.inf  # P and I act on the error clamped to ±this (the "leash")
+    # Act on where the setpoint profile will be this far ahead: a plant that follows its
+    # command this late (a vehicle's lean) then tracks the profile of now. 0: the profile of now.
+    lead_s: float = 0.0
 
     def __post_init__(self) -> None:
         if min(self.kp, self.ki, self.kd, self.i_max) < 0.0:
             raise ValueError(f"PID gains and i_max must be >= 0: {self}")
         if self.out_min >= self.out_max:
             raise ValueError(f"out_min must be < out_max: {self.out_min} >= {self.out_max}")
+        if self.lead_s < 0.0:
+            raise ValueError(f"lead_s must be >= 0, got {self.lead_s}")
         if min(self.d_filter_hz, self.setpoint_slew_per_s, self.setpoint_accel_per_s2,
                self.error_max) <= 0.0:
             raise ValueError("d_filter_hz, the setpoint slew/accel limits and error_max must "
@@ -149,6 +154,18 @@ class Pid:
         self._shaped_rate = rate
         return rate
 
+    def _ahead(self, target: float, dt_s: float,
+               slew_per_s: float | None) -> tuple[float, float, float]:
+        """The profile `lead_s` ahead: (setpoint, its rate, its rate one step before)."""
+        saved = self._shaped, self._shaped_rate
+        prev = self._shaped_rate
+        for _ in range(max(1, round(self.gains.lead_s / dt_s))):
+            prev = self._shaped_rate
+            self._shape(target, dt_s, slew_per_s)
+        ahead = self._shaped, self._shaped_rate, prev
+        self._shaped, self._shaped_rate = saved
+        return ahead  # type: ignore[return-value]
+
     def update(
         self,
         target: float,
@@ -170,11 +187,14 @@ class Pid:
             self._shaped = target
         prev_rate = self._shaped_rate
         shaped_rate = self._shape(target, dt_s, slew_per_s)
+        reference = self._shaped
+        if g.lead_s > 0.0:
+            reference, shaped_rate, prev_rate = self._ahead(target, dt_s, slew_per_s)
         # clamp: the profile's last step onto the target ends its rate in one tick
         accel = min(max((shaped_rate - prev_rate) / dt_s, -g.setpoint_accel_per_s2),
                     g.setpoint_accel_per_s2)
         ff = g.ff_accel * accel
-        error = self._shaped - measurement
+        error = reference - measurement
 
         if measurement_rate is not None:
             d_raw = g.kd * (shaped_rate - measurement_rate)

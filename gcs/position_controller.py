@@ -19,13 +19,15 @@ from gcs.pid import Pid, PidGains
 
 def _default_xy_gains() -> PidGains:
     # The set point moves on a trapezoidal profile (0.7 m/s, 1 m/s²) whose acceleration goes
-    # straight to the lean, and kd damps the rate against the profile's: a jump of the set
-    # point used to leave only P and D to chase it, and the ~0.25 s the attitude takes to follow
-    # the stick made a 0.5 m leg overshoot by 70 % (lockstep, gcs.position_legs: 2.4/1.6 kd and
-    # the profile took it to 55 %, a 2 m leg from 29-32 % to 10-12 %).
+    # straight to the lean, and kd damps the rate against the profile's. The lean follows the
+    # stick some 0.25 s late and the vehicle its lean later still, so the loop acts on the
+    # profile 0.45 s ahead: without that lead braking began too late, and a 0.1 m step (the
+    # flock's) overshot by 74-139 %, a 0.5 m leg by about 50 % (lockstep, gcs.position_legs,
+    # seeds 1-3, both profiles). Stiffer gains with the lead settled faster still (kp 2.5, kd
+    # 3.5) but turned EPBHA's table approach into a detour past the table's legs in 3 of 5 seeds.
     return PidGains(kp=1.2, ki=0.1, kd=2.4, i_max=0.5, out_min=-2.5, out_max=2.5,
                     d_filter_hz=3.0, setpoint_slew_per_s=0.7, setpoint_accel_per_s2=1.0,
-                    ff_accel=1.0)
+                    ff_accel=1.0, lead_s=0.45)
 
 
 @dataclass(frozen=True, slots=True)

@@ -88,8 +88,13 @@ def _build(cls: type, table: dict[str, Any], path: Path, nested: dict[str, type]
             raise UsageError(f"{where}: unknown parameter; expected one of {', '.join(allowed)}")
     for field_name, sub_cls in nested.items():
         if field_name in sub:
+            # the planner's own defaults for the nested table (the flock's leader keeps off
+            # farther than EPBHA alone), with the mission's keys over them
+            default = next((f.default_factory() for f in dataclasses.fields(cls)  # type: ignore[misc]
+                            if f.name == field_name and callable(f.default_factory)),
+                           sub_cls())
             try:
-                kwargs[field_name] = sub_cls(**sub[field_name])
+                kwargs[field_name] = dataclasses.replace(default, **sub[field_name])
             except ValueError as exc:
                 raise UsageError(f"{path}: planner: {exc}") from None
     try:
@@ -111,7 +116,8 @@ def planner_setup(spec: MissionSpec, room_min_n: tuple[float, float] | None = No
     if spec.planner is PlannerKind.EPBHA:
         params = _build(EpbhaParams, table, spec.path)
     elif spec.planner is PlannerKind.FLOCKING:
-        params = _build(FlockParams, table, spec.path, {"formation": FormationParams})
+        params = _build(FlockParams, table, spec.path,
+                        {"formation": FormationParams, "epbha": EpbhaParams})
     else:
         if room_min_n is not None and room_max_n is not None:
             for key, value in (("x_min_m", room_min_n[0] + margin),

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -138,3 +140,28 @@ def test_leash_bounds_p_and_i_on_a_large_error_but_reports_the_error() -> None:
     assert inside.p == pytest.approx(0.4)
     with pytest.raises(ValueError):
         PidGains(kp=1.0, ki=0.0, kd=0.0, i_max=1.0, out_min=-1.0, out_max=1.0, error_max=0.0)
+
+
+def test_lead_acts_on_the_profile_ahead_without_changing_the_profile() -> None:
+    # A plant that follows its command late is aimed at where the profile will be, so that it
+    # brakes in time; the profile itself (the shaped setpoint reported) runs as without lead.
+    base = PidGains(kp=1.0, ki=0.0, kd=1.0, i_max=1.0, out_min=-10, out_max=10,
+                    setpoint_slew_per_s=1.0, setpoint_accel_per_s2=1.0, ff_accel=1.0,
+                    d_filter_hz=1000.0)
+    plain, ahead = Pid(base), Pid(dataclasses.replace(base, lead_s=0.5))
+    for pid in (plain, ahead):
+        pid.engage(0.0, 0.0, 0.0)
+    dt = 0.025
+    for k in range(120):  # a 1 m move: accelerate, brake, arrive
+        a = plain.update(1.0, 0.0, dt, measurement_rate=0.0)
+        b = ahead.update(1.0, 0.0, dt, measurement_rate=0.0)
+        assert b.shaped_target == pytest.approx(a.shaped_target)
+        t = (k + 1) * dt
+        if t + 0.5 <= 0.9:  # both still accelerating at 1 m/s²: half a second further along
+            assert b.error == pytest.approx(0.5 * (t + 0.5) ** 2, abs=0.02)
+            assert b.d == pytest.approx(1.0 * (t + 0.5), abs=0.05)
+        if 0.6 <= t <= 0.9:  # the profile ahead brakes while the profile of now speeds up
+            assert b.ff < 0.0 < a.ff
+    assert a.error == pytest.approx(1.0) and b.error == pytest.approx(1.0)  # both arrived
+    with pytest.raises(ValueError):
+        dataclasses.replace(base, lead_s=-0.1)

@@ -28,6 +28,15 @@ def test_flocking_keys_reach_nested_formation_and_enums(tmp_path: Path) -> None:
     assert (setup.max_steps, setup.seed) == (50, 9)
 
 
+def test_flocking_keys_reach_the_leaders_epbha_over_the_flocks_own_defaults(
+        tmp_path: Path) -> None:
+    spec = spec_with(tmp_path, 'kind = "flocking"\nbody_radius_m = 0.42\nstep_m = 0.1')
+    params = planner_setup(spec).params  # type: ignore[arg-type]
+    assert params.epbha.body_radius_m == 0.42
+    assert params.epbha.keep_off_m == 0.3  # the flock's leader keeps off farther than EPBHA
+    assert params.step_m == 0.1  # a key both know is the flock's
+
+
 def test_radiation_area_defaults_to_the_room_inside_the_margin(tmp_path: Path) -> None:
     spec = spec_with(tmp_path, 'kind = "radiation"\nfloor_margin_m = 1.0\nx_max_m = 5.0')
     setup = planner_setup(spec, (-10.0, -10.0), (10.0, 10.0))  # type: ignore[arg-type]
