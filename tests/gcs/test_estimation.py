@@ -361,7 +361,7 @@ def _off_the_table(seed: int, baro: bool = True) -> tuple[list[float], list[Sona
         baro_alt = 40.0 + 1.05 + baro_rng.normal(0, 0.12)
         r = est.update(imu, sonar, None, t, baro_alt_m=baro_alt if baro else None)
         statuses.append(r.sonar_status)
-        if 8.0 <= t and SonarStatus.REACQUIRED not in statuses[int(8.0 / DT):]:
+        if t >= 8.0 and SonarStatus.REACQUIRED not in statuses[int(8.0 / DT):]:
             errs.append(r.alt_m - (1.05 - 0.72))
     return errs, statuses
 
