@@ -121,10 +121,12 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
         t_fault = run["fault_wall"]
         if t_fault is not None:
             end = t_fault + (case.duration_s + 25.0) / speedup
-            while time.monotonic() < end and not _disarmed_after(watch_udp, t_fault):
-                time.sleep(0.1)  # polling a condition with a deadline
+            watch_udp.wait_until(lambda w: _disarmed_after(w, t_fault),
+                                 end - time.monotonic())
             # two more seconds of motion capture after the disarm: the touchdown's samples
-            time.sleep(min(2.0, max(0.0, end - time.monotonic())))
+            until = min(time.monotonic() + 2.0, end)
+            watch_mocap.wait_until(lambda w: bool(w.mocap) and w.mocap[-1][0] >= until,
+                                   end - time.monotonic())
         params = watch_udp.request_params(("FS_GCS_ENABLE", "FS_GCS_TIMEOUT"), 3.0)
         clock = SimClockMap(watch_mocap.mocap)
         mocap = np.array([(s, h) for _, s, h in watch_mocap.mocap], dtype=float).reshape(-1, 2)

@@ -8,6 +8,7 @@ import select
 import socket
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -32,6 +33,7 @@ class MavWatcher:
         self._mav = mavlink.MAVLink(None, srcSystem=OBSERVER_SYSID, srcComponent=191)
         self._mav.robust_parsing = True
         self._stop = threading.Event()
+        self._news = threading.Condition()  # notified whenever a kept message arrives
         self._thread = threading.Thread(target=self._run, daemon=True, name="mav-watch")
         self._thread.start()
 
@@ -48,8 +50,15 @@ class MavWatcher:
                 return
             self.peer = addr if self.udp else self.peer
             wall = time.monotonic()
-            for m in self._mav.parse_buffer(data) or []:
-                self._keep(m, wall)
+            with self._news:
+                for m in self._mav.parse_buffer(data) or []:
+                    self._keep(m, wall)
+                self._news.notify_all()
+
+    def wait_until(self, predicate: Callable[[MavWatcher], bool], timeout_s: float) -> bool:
+        """Block until `predicate(self)` holds (checked as messages arrive); False on timeout."""
+        with self._news:
+            return self._news.wait_for(lambda: predicate(self), max(timeout_s, 0.0))
 
     def _keep(self, m: Any, wall: float) -> None:
         kind = m.get_type()
@@ -72,15 +81,17 @@ class MavWatcher:
             for n in missing:
                 msg = mavlink.MAVLink_param_request_read_message(1, 1, n.encode(), -1)
                 self.sock.sendto(msg.pack(self._mav), self.peer)
-            end = time.monotonic() + 0.3
-            while time.monotonic() < end and any(n not in self.params for n in missing):
-                time.sleep(0.02)  # the reader thread fills self.params
+            self.wait_until(_having(missing), 0.3)
         return {n: self.params[n] for n in names if n in self.params}
 
     def close(self) -> None:
         self._stop.set()
         self._thread.join(2.0)
         self.sock.close()
+
+
+def _having(names: list[str]) -> Callable[[MavWatcher], bool]:
+    return lambda w: all(n in w.params for n in names)
 
 
 class StationTap:

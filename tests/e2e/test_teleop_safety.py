@@ -88,10 +88,9 @@ async def test_quit_mid_air_asks_then_lands_before_letting_go(tmp_path: Path) ->
                 quit_at = time.monotonic()
                 await pilot.press("y")
             # the app is gone and its station process has ended: the vehicle must be landing
-            deadline = quit_at + 25.0
-            while time.monotonic() < deadline and not any(
-                    w > quit_at and not armed for w, armed, _ in watch.heartbeats):
-                time.sleep(0.1)  # polling a condition with a deadline
+            watch.wait_until(lambda m: any(w > quit_at and not armed
+                                           for w, armed, _ in m.heartbeats),
+                             quit_at + 25.0 - time.monotonic())
             modes = [mode for w, _, mode in watch.heartbeats if w > quit_at]
             assert 9 in modes, f"never in LAND after the quit: {modes}"
             assert any(w > quit_at and not armed for w, armed, _ in watch.heartbeats)

@@ -1,29 +1,31 @@
 """A station stand-in for the crash test: records a 40 Hz tick until it is killed.
 
 Prints `seq t_s` for every tick it has put, so the parent knows what was handed to the recorder.
+The ticks run on the station's own fixed-rate loop and clock.
 """
 
 from __future__ import annotations
 
 import sys
-import time
 
+from gcs.clock import MonotonicClock
+from gcs.loop import FixedRateLoop
 from logs import Recorder
 
 
 def main(path: str) -> None:
     """Record /tick at 40 Hz forever."""
     rec = Recorder(path, metadata={"purpose": "crash test"}, flush_interval_s=1.0)
-    seq = 0
-    next_t = time.monotonic()
-    while True:
-        t = time.monotonic()
-        rec.put("/tick", t, {"seq": seq, "alt_m": 0.01 * seq})
-        rec.put_raw("rx", t, bytes([0xFD, 1, 0, 0, seq % 256, 1, 1, 0, 0, 0, 7, 0, 0]))
-        print(seq, repr(t), flush=True)
-        seq += 1
-        next_t += 0.025
-        time.sleep(max(0.0, next_t - time.monotonic()))  # pacing the 25 ms loop, not syncing
+    put = 0  # ticks put, in order (the loop's own index skips the deadlines it missed)
+
+    def tick(_k: int, t_s: float, _period_s: float) -> None:
+        nonlocal put
+        rec.put("/tick", t_s, {"seq": put, "alt_m": 0.01 * put})
+        rec.put_raw("rx", t_s, bytes([0xFD, 1, 0, 0, put % 256, 1, 1, 0, 0, 0, 7, 0, 0]))
+        print(put, repr(t_s), flush=True)
+        put += 1
+
+    FixedRateLoop(MonotonicClock(), 0.025, tick).run()
 
 
 if __name__ == "__main__":
