@@ -40,6 +40,7 @@ class LockstepSession(StationSession):
     """Context manager: the vehicles' stations on the bundled SITL's simulated clock."""
 
     recording_anchor_ns = LOCKSTEP_EPOCH_NS
+    recording_blocks = True  # no wall clock to keep up with: nothing recorded may be dropped
 
     def __init__(self, options: SessionOptions, *, world: Any = None,
                  config: StationConfig | None = None, noise: bool = True,

@@ -121,6 +121,8 @@ class StationSession:
 
     # UTC nanoseconds at the clock's zero in recordings; None: the monotonic clock's zero
     recording_anchor_ns: int | None = None
+    # a recorder that cannot keep up makes the station wait (simulated time) instead of dropping
+    recording_blocks = False
 
     def __init__(self, options: SessionOptions) -> None:
         options.validate()
@@ -239,7 +241,8 @@ class StationSession:
                     "profile": o.profile, **{k: str(v) for k, v in o.metadata.items()}}
             try:
                 recorder = Recorder(o.output, metadata=meta, vehicle=f"vehicle{sysid}",
-                                    anchor_ns=self.recording_anchor_ns)
+                                    anchor_ns=self.recording_anchor_ns,
+                                    block_when_full=self.recording_blocks)
             except RecordingError as exc:
                 raise UsageError(f"-o {o.output}: {exc}") from None
             stack.callback(recorder.close)

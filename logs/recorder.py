@@ -188,6 +188,7 @@ class Recorder:
         flush_interval_s: float = 1.0,
         max_queue: int = 100_000,
         anchor_ns: int | None = None,
+        block_when_full: bool = False,
     ) -> None:
         if not flush_interval_s > 0:
             raise RecordingError(f"flush_interval_s must be > 0 s, got {flush_interval_s!r}")
@@ -199,8 +200,13 @@ class Recorder:
         self._sink = McapSink(self._path)
         self._flush_interval_s = float(flush_interval_s)
         self._max_queue = int(max_queue)
+        # A real-time loop must never wait for the disk, so a full queue drops (and counts). A
+        # simulated-time producer (a lockstep flight, far faster than real time) waits for the
+        # writer instead: nothing it records is lost.
+        self._block = bool(block_when_full)
         self._queue: deque[tuple[_Kind, str, float, Any]] = deque()
         self._wake = threading.Event()
+        self._drained = threading.Event()  # the writer took a slice off the queue
         self._closing = False
         self._closed = False
         self._drop_lock = threading.Lock()
@@ -281,6 +287,12 @@ class Recorder:
         self._enqueue(_Kind.METADATA, name, 0.0, dict(data))
 
     def _enqueue(self, kind: _Kind, topic: str, t_s: float, payload: Any) -> None:
+        if self._block:
+            while (len(self._queue) >= self._max_queue and not self._closing
+                   and self._error is None and self._thread.is_alive()):
+                self._drained.clear()
+                self._wake.set()
+                self._drained.wait(0.1)
         if self._closing or len(self._queue) >= self._max_queue:
             with self._drop_lock:
                 self._dropped[topic] = self._dropped.get(topic, 0) + 1
@@ -331,8 +343,10 @@ class Recorder:
                 if time.perf_counter() > slice_end:
                     # Hand the GIL over: a loop thread waiting for it would otherwise wait for
                     # the interpreter's switch interval (5 ms), a fifth of a control tick.
+                    self._drained.set()
                     time.sleep(0)
                     slice_end = time.perf_counter() + YIELD_AFTER_S
+            self._drained.set()
             now = time.monotonic()
             if self._closing and not queue:
                 break

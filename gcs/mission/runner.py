@@ -38,7 +38,9 @@ def _open_recorder(spec: MissionSpec, options: RunOptions, mode: str) -> Any:
     meta = {"command": "mission", "mission": spec.name, "planner": spec.planner.value,
             "mode": mode, "mission_file": str(spec.path), "mission_text": spec.text}
     try:
-        return Recorder(options.output, metadata=meta, vehicle=f"mission-{spec.name}")
+        # the kinematic world runs as fast as it computes: the recorder makes it wait, never drops
+        return Recorder(options.output, metadata=meta, vehicle=f"mission-{spec.name}",
+                        block_when_full=mode == "kinematic")
     except RecordingError as exc:
         raise UsageError(f"-o {options.output}: {exc}") from None
 

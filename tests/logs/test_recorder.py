@@ -155,6 +155,19 @@ def test_full_queue_drops_and_counts(tmp_path: Path) -> None:
     assert warnings[-1].endswith(f"({stats.dropped['/burst']} in all)")  # the hole is in the file
 
 
+def test_a_simulated_time_producer_waits_for_the_writer_and_loses_nothing(
+        tmp_path: Path) -> None:
+    # the same burst into the same small queue, from a lockstep flight: it waits instead
+    n = 20_000
+    rec = Recorder(tmp_path / "r.mcap", metadata={}, max_queue=50, block_when_full=True)
+    for i in range(n):
+        rec.put("/burst", i * 1e-4, {"i": i})
+    rec.close()
+    assert rec.stats.dropped == {} and rec.stats.written["/burst"] == n
+    recording = open_recording(rec.path)
+    assert [m["i"] for _t, _ns, m in recording.messages(["/burst"])] == list(range(n))
+
+
 def test_put_after_close_is_counted_as_dropped(tmp_path: Path) -> None:
     rec = Recorder(tmp_path / "r.mcap", metadata={})
     rec.close()
