@@ -285,6 +285,12 @@ def test_late_echo_corrects_the_altitude_of_its_ping_not_of_now() -> None:
     assert np.max(np.abs(est[k:] - truth[k:])) < 0.05
 
 
+def _shaken_imu(t: float, rng: np.random.Generator) -> Imu:
+    """A hovering vehicle's IMU sample: 0.1 m/s² of bias and heavy vibration (0.6 m/s²)."""
+    f = body_specific_force(0.1 + rng.normal(0, 0.6), 0.0, 0.0)
+    return Imu(t_s=t, sysid=1, acc_b=f, gyro_b=(0, 0, 0), source="RAW_IMU")
+
+
 def _hover_with_gap(baro: bool, seed: int = 5) -> tuple[list[float], list[float]]:
     """Hover at 1 m with heavy vibration; the sonar goes silent from 6 to 7.5 s (carpet)."""
     est = KalmanEstimator()
@@ -293,8 +299,7 @@ def _hover_with_gap(baro: bool, seed: int = 5) -> tuple[list[float], list[float]
     alts, errs = [], []
     for k in range(int(9.0 / DT)):
         t = k * DT
-        f = body_specific_force(0.1 + rng.normal(0, 0.6), 0.0, 0.0)
-        imu = Imu(t_s=t, sysid=1, acc_b=f, gyro_b=(0, 0, 0), source="RAW_IMU")
+        imu = _shaken_imu(t, rng)
         sonar = None
         if k % 2 == 0 and not 6.0 <= t < 7.5:
             sonar = Rangefinder(t, 1, 1.0 + rng.normal(0, 0.01), True, "RANGEFINDER")
@@ -351,8 +356,7 @@ def _off_the_table(seed: int, baro: bool = True) -> tuple[list[float], list[Sona
     errs, statuses = [], []
     for k in range(int(13.0 / DT)):
         t = k * DT
-        f = body_specific_force(0.1 + rng.normal(0, 0.6), 0.0, 0.0)
-        imu = Imu(t_s=t, sysid=1, acc_b=f, gyro_b=(0, 0, 0), source="RAW_IMU")
+        imu = _shaken_imu(t, rng)
         sonar = None
         if k % 2 == 0:
             below = 0.72 if t < 8.0 else 0.0
