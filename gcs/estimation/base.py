@@ -71,6 +71,7 @@ class EstimatorParams:
     baro_sigma_m: float = 0.15
     baro_offset_walk_m_per_sqrt_s: float = 0.01
     baro_min_alt_m: float = 0.4  # below, rotor downwash off the floor biases it (unless disarmed)
+    surface_step_m: float = 0.3  # a sonar range this far beyond the estimate: another surface
     sonar_offset_m: float = 0.0  # sonar mounted this far below the centre of gravity (body z)
     rest_alt_m: float = 0.0  # centre-of-gravity height when standing on the floor
     complementary_tc_s: float = 1.0  # T of the third-order filter (gains 3/T, 3/T², 1/T³)
@@ -159,8 +160,6 @@ class AltEstimator(ABC):
         self._initialised = False
         self._reject_run_start_s = 0.0
         self._reject_seen_s = -math.inf  # last rejected reading, or a repeat of it
-        self._range_m = 0.0  # the last valid sonar range, accepted or not, and its tick
-        self._range_t_s = -math.inf
 
     @abstractmethod
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
@@ -220,13 +219,14 @@ class AltEstimator(ABC):
             status, innovation = self._sonar(sonar, t_s, alt_before)
         if at_rest and self._state()[0] < p.ground_alt_m:
             self._at_rest()
-        # Downwash off the surface below biases the barometer. Which surface: the estimate's, or
-        # the one the sonar sees now even when its reading is rejected. Past a table's edge
-        # the estimate still measures from the table top until it re-bases; shutting the
-        # barometer out then would leave it to the accelerometer alone for seconds.
-        seen_clear = (t_s - self._range_t_s <= p.stale_after_s
-                      and self._range_m >= p.baro_min_alt_m)
-        clear = self._state()[0] >= p.baro_min_alt_m or seen_clear
+        # Downwash off the surface below biases the barometer. Which surface: the estimate's,
+        # or, past a table's edge, the floor the sonar steadily sees far below it (the readings
+        # the estimate rejects while it still measures from the table top, until it re-bases):
+        # shutting the barometer out would leave it to the accelerometer alone for seconds.
+        # Only steady readings: over carpet a lost echo reads long now and then, and near the
+        # floor on take-off that let the downwash into the barometer's offset.
+        alt = self._state()[0]
+        clear = alt >= p.baro_min_alt_m or self._steady_far_below(alt)
         if baro_alt_m is not None and self._initialised and (at_rest or clear):
             self._baro(baro_alt_m, coasting=t_s - self._last_sonar_t_s > p.stale_after_s)
         alt, vel, bias, sigma = self._state()
@@ -245,6 +245,14 @@ class AltEstimator(ABC):
             alt_sigma_m=sigma,
             rejected_total=self._rejected_total,
         )
+
+    def _steady_far_below(self, alt_m: float) -> bool:
+        """The rejected readings of late agree on a surface far below the estimate's."""
+        p = self.params
+        recent = [z for _, z in self._rejected]
+        return (len(recent) >= p.reacquire_count
+                and max(recent) - min(recent) <= p.reacquire_spread_m
+                and min(recent) >= max(p.baro_min_alt_m, alt_m + p.surface_step_m))
 
     def _alt_at(self, t_s: float) -> float:
         """The estimate as it was at `t_s` (the oldest kept when older)."""
@@ -271,8 +279,6 @@ class AltEstimator(ABC):
 
     def _sonar(self, sonar: Rangefinder, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
         d = sonar.distance_m if sonar.valid else 0.0
-        if d > self.params.sonar_min_m:
-            self._range_m, self._range_t_s = d, t_s
         # the message's own arrival (receive stamp) times the repeat test; the tick's time
         # (`t_s`) times everything the filter does with the reading
         fresh = self._is_new_reading(d, sonar.t_s)
