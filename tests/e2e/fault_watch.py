@@ -71,6 +71,14 @@ class MavWatcher:
         elif kind == "PARAM_VALUE":
             self.params[m.param_id] = float(m.param_value)
 
+    def wait_sim(self, seconds: float, timeout_s: float = 60.0) -> bool:
+        """Block until the SITL's clock (the motion-capture stamps) has moved on `seconds`."""
+        with self._news:
+            if not self.wait_until(lambda w: bool(w.mocap), timeout_s):
+                return False
+            start = self.mocap[-1][1]
+        return self.wait_until(lambda w: w.mocap[-1][1] >= start + seconds, timeout_s)
+
     def request_params(self, names: tuple[str, ...], timeout_s: float) -> dict[str, float]:
         """Read parameters over this (UDP) endpoint, as an observer that is not the GCS."""
         deadline = time.monotonic() + timeout_s

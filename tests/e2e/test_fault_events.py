@@ -113,25 +113,25 @@ def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float =
                                 cwd=ROOT, env=dict(os.environ, PYTHONUNBUFFERED="1"))
         event_wall: list[float] = []
         err: list[str] = []
+        fired = threading.Event()  # the trigger ran, or fly's output ended without the phase
 
         def read() -> None:
             assert proc.stdout is not None
             for line in proc.stdout:
                 if not event_wall and line.startswith(phase + " "):
-                    time.sleep(after_s / SPEEDUP)  # pacing the trigger, not synchronising
-                    trigger(proc, proxy, watch_udp)
+                    watch_mocap.wait_sim(after_s)  # on the SITL's clock
+                    trigger(proc, proxy, watch_mocap)
                     event_wall.append(time.monotonic())
+                    fired.set()
+            fired.set()
 
         readers = [threading.Thread(target=read, daemon=True),
                    threading.Thread(target=lambda: err.extend(proc.stderr or []), daemon=True)]
         for r in readers:
             r.start()
-        deadline = time.monotonic() + 200.0
-        while time.monotonic() < deadline and not event_wall and proc.poll() is None:
-            time.sleep(0.05)  # polling a condition with a deadline
-        end = (event_wall[0] if event_wall else time.monotonic()) + watch_s / SPEEDUP
-        while time.monotonic() < end:
-            time.sleep(0.05)
+        fired.wait(200.0)
+        # keep watching `watch_s` simulated seconds after the trigger (or after fly ended)
+        watch_mocap.wait_sim(watch_s, timeout_s=watch_s / SPEEDUP + 30.0)
         try:
             code = proc.wait(timeout=60.0)
         except subprocess.TimeoutExpired:
@@ -184,9 +184,9 @@ def test_auto_disarm_before_takeoff_is_reported_and_nothing_winds_up() -> None:
 
 
 def _kill_in_fault(direction: Direction, fault_s: float) -> Trigger:
-    def trigger(proc: subprocess.Popen[str], proxy: FaultProxy, _w: MavWatcher) -> None:
+    def trigger(proc: subprocess.Popen[str], proxy: FaultProxy, watch: MavWatcher) -> None:
         proxy.drop(direction, fault_s)
-        time.sleep(1.5 / SPEEDUP)  # the fault has begun: the station is blind or unheard
+        watch.wait_sim(1.5)  # the fault has begun: the station is blind or unheard
         proc.send_signal(signal.SIGQUIT)
     return trigger
 
