@@ -42,9 +42,10 @@ Where this code departs from the text, and why:
   seen; the back-off is a staircase of axis steps (back, side, back, …), each along a cone axis.
 - The "no detection range offset" of Subfunction 2 is `keep_off_m`: a move is taken only when
   its sensor sees nothing nearer than step + keep_off, and anything nearer than keep_off on
-  any side is first backed away from. Manoeuvres continue a few steps beyond the step where an
-  edge leaves the sensor cone, because a 22.5° half-cone stops seeing an edge at lateral offset
-  seen·tan 22.5°, before the body (radius `body_radius_m`) has cleared it.
+  any side is first backed away from (up and down the offset may be smaller,
+  `keep_off_vertical_m`: the body is a flat disk). Manoeuvres continue a few steps beyond the
+  step where an edge leaves the sensor cone, because a 22.5° half-cone stops seeing an edge
+  at lateral offset seen·tan 22.5°, before the body (radius `body_radius_m`) has cleared it.
 - Going around, the thesis moves sideways until the way is clear and then on; a side cone does
   not see a table top it is passing (the edge sits in the gap between cones), so passing
   alongside continues at least as far as the face that blocked the way, plus the body radius.
@@ -196,7 +197,7 @@ class Epbha:
     def _sensor_free(self, reading: ProximityReading, move: Move) -> bool:
         """The move's own sensor sees nothing nearer than a step plus the keep-off distance."""
         seen = reading.along_n(move.vec())
-        return seen is None or seen >= self.params.blocked_below_m
+        return seen is None or seen >= self.params.blocked_below(move)
 
     def _free(self, pos: Vec3, reading: ProximityReading, move: Move) -> bool:
         """The move's sensor sees nothing near and the swept body clears every return seen."""
@@ -327,7 +328,7 @@ class Epbha:
         nearest: tuple[float, Move] | None = None
         for move in Move:
             seen = reading.along_n(move.vec())
-            if seen is not None and seen < self.params.keep_off_m - 1e-9 and (
+            if seen is not None and seen < self.params.keep_off(move) - 1e-9 and (
                 nearest is None or seen < nearest[0]
             ):
                 nearest = (seen, move)
@@ -421,7 +422,8 @@ class Epbha:
             return None
 
         if man.kind is ObstacleClass.PARTITION:
-            above_lid = man.lid_z_m is None or pos[2] < man.lid_z_m - self.params.keep_off_m
+            above_lid = (man.lid_z_m is None
+                         or pos[2] < man.lid_z_m - self.params.keep_off(Move.UP))
             man.clear_steps = man.watch(reading, man.heading, self.params.sensor_range_m)
             if not above_lid:
                 man.clear_steps = 0

@@ -100,6 +100,11 @@ class EpbhaParams:
     sensor_range_m: float = 0.5  # §8.6
     sensor_cone_deg: float = 45.0  # §8.6, full cone angle
     keep_off_m: float = 0.25  # Subfunction 2's offset: the 0.15 m body plus 10 cm
+    # The same offset above and below (None: keep_off_m, as the thesis has it). A quadrotor is
+    # a flat disk: under a table its sensors at mid-body need its half-height plus the height
+    # hold's error, not its radius, and a gap too narrow for 2 x keep_off_m would make a hold
+    # a centimetre high step down onto whatever lies below.
+    keep_off_vertical_m: float | None = None
     body_radius_m: float = 0.17  # edge clearance wanted: the 0.15 m body plus 2 cm
     # A move's path must keep this far from every return remembered: the 0.15 m body plus 2 cm.
     # Not body_radius_m, which a mission may raise for position-hold error around edges seen.
@@ -118,11 +123,15 @@ class EpbhaParams:
             raise ValueError("EPBHA weights A and B must be > 0")
         if not self.sensor_range_m > 0.0 or self.keep_off_m < 0.0:
             raise ValueError("EPBHA sensor_range_m must be > 0 and keep_off_m >= 0")
-        if self.step_m + self.keep_off_m >= self.sensor_range_m:
-            raise ValueError(
-                f"EPBHA step_m + keep_off_m ({self.step_m + self.keep_off_m} m) must be below "
-                f"the sensor range ({self.sensor_range_m} m), or a blocked move is never seen"
-            )
+        if self.keep_off_vertical_m is not None and self.keep_off_vertical_m < 0.0:
+            raise ValueError("EPBHA keep_off_vertical_m must be >= 0")
+        for name, k in (("keep_off_m", self.keep_off_m),
+                        ("keep_off_vertical_m", self.keep_off_vertical_m or 0.0)):
+            if self.step_m + k >= self.sensor_range_m:
+                raise ValueError(
+                    f"EPBHA step_m + {name} ({self.step_m + k} m) must be below the sensor "
+                    f"range ({self.sensor_range_m} m), or a blocked move is never seen"
+                )
         if not self.max_alt_m > 0.0:
             raise ValueError(f"EPBHA max_alt_m must be > 0, got {self.max_alt_m}")
         if self.body_radius_m < 0.0 or self.max_visits < 1:
@@ -132,10 +141,15 @@ class EpbhaParams:
         if self.memory_steps < 1:
             raise ValueError(f"EPBHA memory_steps must be >= 1, got {self.memory_steps}")
 
-    @property
-    def blocked_below_m(self) -> float:
+    def keep_off(self, move: Move) -> float:
+        """Subfunction 2's offset along `move`: the vertical one up and down."""
+        if move in (Move.UP, Move.DOWN) and self.keep_off_vertical_m is not None:
+            return self.keep_off_vertical_m
+        return self.keep_off_m
+
+    def blocked_below(self, move: Move) -> float:
         """A move is blocked when its sensor sees something nearer than this."""
-        return self.step_m + self.keep_off_m
+        return self.step_m + self.keep_off(move)
 
 
 @dataclass(frozen=True, slots=True)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import types
 import typing
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,6 +47,11 @@ class PlannerSetup:
 
 def _convert(value: Any, hint: Any, where: str) -> Any:
     origin = typing.get_origin(hint)
+    args = typing.get_args(hint)
+    if origin in (typing.Union, types.UnionType) and type(None) in args:
+        # TOML has no null: an optional parameter given is a value of its other type
+        (inner,) = (a for a in args if a is not type(None))
+        return _convert(value, inner, where)
     if isinstance(hint, type) and issubclass(hint, enum.Enum):
         try:
             return hint(value)

@@ -37,6 +37,14 @@ def test_flocking_keys_reach_the_leaders_epbha_over_the_flocks_own_defaults(
     assert params.step_m == 0.1  # a key both know is the flock's
 
 
+def test_an_optional_parameter_takes_its_type_and_is_checked(tmp_path: Path) -> None:
+    spec = spec_with(tmp_path, 'kind = "epbha"\nkeep_off_vertical_m = 0.15')
+    assert planner_setup(spec).params.keep_off_vertical_m == 0.15  # type: ignore[arg-type]
+    spec = spec_with(tmp_path, 'kind = "epbha"\nkeep_off_vertical_m = "low"')
+    with pytest.raises(UsageError, match=r"planner\.keep_off_vertical_m: expected float"):
+        planner_setup(spec)  # type: ignore[arg-type]
+
+
 def test_radiation_area_defaults_to_the_room_inside_the_margin(tmp_path: Path) -> None:
     spec = spec_with(tmp_path, 'kind = "radiation"\nfloor_margin_m = 1.0\nx_max_m = 5.0')
     setup = planner_setup(spec, (-10.0, -10.0), (10.0, 10.0))  # type: ignore[arg-type]

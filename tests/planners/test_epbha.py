@@ -132,6 +132,29 @@ def test_keep_off_backs_away_from_a_near_obstacle() -> None:
     assert d.next_pos_n == pytest.approx((0.0, 0.0, -0.9))
 
 
+def test_a_vertical_keep_off_lets_a_hold_a_little_high_fly_on_under_a_table() -> None:
+    # under a table top 0.24 m above the sensors, the floor 0.48 m below: the thesis's one
+    # offset steps down toward whatever is below; the flat body's vertical offset flies on
+    under_table = reading(up=0.24, down=0.48)
+    assert planner().step(START, under_table).reason is Reason.KEEP_OFF
+    p = Epbha(EpbhaParams(keep_off_vertical_m=0.15), (2.0, 0.0, -1.0), START)
+    d = p.step(START, under_table)
+    assert d.reason is Reason.COST and d.next_pos_n == pytest.approx((0.1, 0.0, -1.0))
+    # nearer than the vertical offset it still backs away, and sideways the radius counts
+    p = Epbha(EpbhaParams(keep_off_vertical_m=0.15), (2.0, 0.0, -1.0), START)
+    d = p.step(START, reading(up=0.12, down=0.48))
+    assert d.reason is Reason.KEEP_OFF and d.next_pos_n == pytest.approx((0.0, 0.0, -0.9))
+    p = Epbha(EpbhaParams(keep_off_vertical_m=0.15), (2.0, 0.0, -1.0), START)
+    assert p.step(START, reading(front=0.2)).reason is Reason.KEEP_OFF
+
+
+def test_a_vertical_keep_off_beyond_the_sensor_range_is_refused() -> None:
+    with pytest.raises(ValueError, match="keep_off_vertical_m"):
+        EpbhaParams(keep_off_vertical_m=0.45)
+    with pytest.raises(ValueError, match="keep_off_vertical_m"):
+        EpbhaParams(keep_off_vertical_m=-0.1)
+
+
 def test_xy_goal_then_yz_goal_then_reached() -> None:
     p = planner((0.0, 0.0, -0.8))
     d = p.step(START, ProximityReading.clear())
