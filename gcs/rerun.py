@@ -223,10 +223,8 @@ def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunO
         attitude = frame.attitudes[-1] if frame.attitudes else None
         sonars = frame.sonars
         baro = baro_altitude_m(frame.baros[-1].pressure_pa) if frame.baros else None
-        est = estimator.update(average_imu(list(frame.imus)), sonars[0] if sonars else None,
-                               attitude, t.t_s, at_rest=t.at_rest, baro_alt_m=baro)
-        for extra in sonars[1:]:
-            est = estimator.update(None, extra, None, t.t_s)
+        est = estimator.update_tick(average_imu(list(frame.imus)), sonars, attitude, t.t_s,
+                                    at_rest=t.at_rest, baro_alt_m=baro)
         estimates[frame.log_ns] = est
         sup.step(TickIn(
             t_s=t.t_s, dt_s=t.dt_s, intents=frame.intents,

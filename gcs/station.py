@@ -344,11 +344,9 @@ class Station(StationIntents):
         # is on the floor); before the first heartbeat nothing is known
         at_rest = (status.seen and not status.armed
                    and status.frame_age_s <= self.supervisor_params.lost_after_s)
-        est = self.estimator.update(
-            imu, sonars[0] if sonars else None, attitude, t_s, at_rest=at_rest,
+        est = self.estimator.update_tick(
+            imu, sonars, attitude, t_s, at_rest=at_rest,
             baro_alt_m=None if baro is None else baro_altitude_m(baro.pressure_pa))
-        for extra in sonars[1:]:
-            est = self.estimator.update(None, extra, None, t_s)
         self._estimate = est
         att = self._latest.get(Attitude)
         pose = self._latest.get(MocapPose)

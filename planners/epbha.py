@@ -212,10 +212,11 @@ class Epbha:
         may still move clearly away from it, by at least half a step.
         """
         body = self.params.swept_clearance_m - 1e-9
-        if self._memory.segment_clearance(pos, next_pos) >= body:
+        z = self.params.swept_z_scale
+        if self._memory.segment_clearance(pos, next_pos, z) >= body:
             return True
-        here = self._memory.segment_clearance(pos, pos)
-        there = self._memory.segment_clearance(next_pos, next_pos)
+        here = self._memory.segment_clearance(pos, pos, z)
+        there = self._memory.segment_clearance(next_pos, next_pos, z)
         return there >= min(body, here + self.params.step_m / 2.0)
 
     def _active(self, reading: ProximityReading, move: Move) -> bool:

@@ -109,6 +109,9 @@ class EpbhaParams:
     # A move's path must keep this far from every return remembered: the 0.15 m body plus 2 cm.
     # Not body_radius_m, which a mission may raise for position-hold error around edges seen.
     swept_clearance_m: float = 0.17
+    # The same above and below (None: swept_clearance_m). The flat body's vertical need is its
+    # half-height plus the height hold's error: a table top 0.2 m over the sensors is clear.
+    swept_clearance_vertical_m: float | None = None
     # Returns are remembered for this many readings (0.3 m of travel): long enough to keep an
     # edge that slipped into a blind wedge, short enough that a cap's rim, never resolved across
     # the plane the vehicle moves in, does not shut passages it has already measured.
@@ -138,8 +141,19 @@ class EpbhaParams:
             raise ValueError("EPBHA body_radius_m must be >= 0 and max_visits >= 1")
         if self.swept_clearance_m < 0.0:
             raise ValueError(f"EPBHA swept_clearance_m must be >= 0, got {self.swept_clearance_m}")
+        v = self.swept_clearance_vertical_m
+        if v is not None and not v > 0.0:
+            raise ValueError(f"EPBHA swept_clearance_vertical_m must be > 0, got {v}")
         if self.memory_steps < 1:
             raise ValueError(f"EPBHA memory_steps must be >= 1, got {self.memory_steps}")
+
+    @property
+    def swept_z_scale(self) -> float:
+        """How much farther a remembered return above or below counts than one beside."""
+        v = self.swept_clearance_vertical_m
+        if v is None or self.swept_clearance_m == 0.0:
+            return 1.0
+        return self.swept_clearance_m / v
 
     def keep_off(self, move: Move) -> float:
         """Subfunction 2's offset along `move`: the vertical one up and down."""

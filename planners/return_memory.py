@@ -93,11 +93,16 @@ class ReturnMemory:
                 old = self._points.get(key)
                 self._points[key] = group if old is None else np.concatenate((old, group))
 
-    def segment_clearance(self, a_n: Vec3, b_n: Vec3) -> float:
+    def segment_clearance(self, a_n: Vec3, b_n: Vec3, z_scale: float = 1.0) -> float:
         """A lower bound on the distance from segment a-b to any possibly occupied point (m).
 
-        `math.inf` when no remembered point lies within the sensor range of the segment.
+        `z_scale` > 1 stretches vertical offsets (a flat body: a point above counts as that
+        many times farther away, so an ellipsoid of semi-axes (c, c, c / z_scale) is clear
+        when the result is at least c). `math.inf` when no remembered point lies within the
+        sensor range of the segment.
         """
+        if not z_scale > 0.0:
+            raise ValueError(f"return memory z_scale must be > 0, got {z_scale}")
         reach = self.range_m + math.dist(a_n, b_n)
         mid = tuple((u + v) / 2.0 for u, v in zip(a_n, b_n, strict=True))
         parts = [self._points[k] for k in _buckets_within(mid, reach) if k in self._points]
@@ -105,12 +110,14 @@ class ReturnMemory:
         pts = pts[pts[:, 4] > self._readings - self.horizon]
         if pts.shape[0] == 0:
             return math.inf
-        a = np.asarray(a_n, dtype=float)
-        ab = np.asarray(b_n, dtype=float) - a
+        stretch = np.array([1.0, 1.0, z_scale])
+        a = np.asarray(a_n, dtype=float) * stretch
+        ab = np.asarray(b_n, dtype=float) * stretch - a
         denom = float(ab @ ab)
-        ap = pts[:, 0:3] - a
+        ap = pts[:, 0:3] * stretch - a
         t = np.clip(ap @ ab / denom, 0.0, 1.0) if denom > 0.0 else np.zeros(len(pts))
-        d = np.linalg.norm(ap - t[:, None] * ab, axis=1) - pts[:, 3]
+        # a point's patch (a ball of its margin) stretched is inside the ball of the larger axis
+        d = np.linalg.norm(ap - t[:, None] * ab, axis=1) - pts[:, 3] * max(1.0, z_scale)
         return max(0.0, float(d.min()))
 
     def _cones_near(self, p: Vec3, radius_m: float) -> np.ndarray:

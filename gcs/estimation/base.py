@@ -6,7 +6,8 @@ import enum
 import math
 from abc import ABC, abstractmethod
 from collections import deque
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 
 from firmware_link.records import Attitude, Imu, Rangefinder
 from gcs.estimation.inputs import sonar_altitude_m, vertical_accel_up_mps2
@@ -106,7 +107,9 @@ class SonarStatus(enum.Enum):
     INVALID = "invalid"  # out of range / zero in the air
     DUPLICATE = "duplicate"  # the stream repeating a reading the sensor has not replaced
     REJECTED = "rejected"  # failed the innovation gate (outlier, late echo)
-    REACQUIRED = "reacquired"  # consistent readings after rejections: estimate reset to them
+    # consistent readings after rejections (estimate reset to them), or one reading that moved
+    # the estimate by a surface step (accepted through a gate widened by a long coast)
+    REACQUIRED = "reacquired"
 
 
 @dataclass(frozen=True, slots=True)
@@ -217,6 +220,12 @@ class AltEstimator(ABC):
         innovation = 0.0
         if sonar is not None:
             status, innovation = self._sonar(sonar, t_s, alt_before)
+            if (status is SonarStatus.USED
+                    and abs(self._state()[0] - alt_before) >= p.surface_step_m):
+                # After a long coast the gate is wide and one reading can move the estimate by
+                # a table's height (the floor past its edge): that is a re-base, not a climb,
+                # and the controller must hear it as one or it dives for the old surface.
+                status = SonarStatus.REACQUIRED
         if at_rest and self._state()[0] < p.ground_alt_m:
             self._at_rest()
         # Downwash off the surface below biases the barometer. Which surface: the estimate's,
@@ -245,6 +254,32 @@ class AltEstimator(ABC):
             alt_sigma_m=sigma,
             rejected_total=self._rejected_total,
         )
+
+    def update_tick(
+        self,
+        imu: Imu | None,
+        sonars: Sequence[Rangefinder],
+        attitude: Attitude | None,
+        t_s: float,
+        at_rest: bool = False,
+        baro_alt_m: float | None = None,
+    ) -> AltEstimate:
+        """One control tick: `update` with the tick's first sonar reading, then each later one.
+
+        A tick can bring two readings (the sonar's rate beats against the loop's). When one of
+        them re-based the estimate on another surface, the tick's estimate says so, whatever
+        the later one did: the controller must move its setpoint by the jump, or it holds a
+        table's height as an error and dives for the surface it just left.
+        """
+        est = self.update(imu, sonars[0] if sonars else None, attitude, t_s, at_rest=at_rest,
+                          baro_alt_m=baro_alt_m)
+        rebased = est.sonar_status is SonarStatus.REACQUIRED
+        for extra in sonars[1:]:
+            est = self.update(None, extra, None, t_s)
+            rebased = rebased or est.sonar_status is SonarStatus.REACQUIRED
+        if rebased and est.sonar_status is not SonarStatus.REACQUIRED:
+            est = replace(est, sonar_status=SonarStatus.REACQUIRED, sonar_used=True)
+        return est
 
     def _steady_far_below(self, alt_m: float) -> bool:
         """The rejected readings of late agree on a surface far below the estimate's."""

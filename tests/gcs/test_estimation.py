@@ -213,6 +213,49 @@ def test_consistent_disagreement_reacquires() -> None:
     assert recs[-1].sonar_status in (SonarStatus.NONE, SonarStatus.USED)
 
 
+def test_a_re_base_on_either_reading_of_a_tick_is_the_ticks_status() -> None:
+    # two sonar readings in some ticks (the sensor's rate beats against the loop's); the
+    # vehicle flies off a table's edge (0.25 m over its top, 1.0 m over the floor): the tick in
+    # which the estimate re-bases must say so, even when the reading after it was simply used
+    rng = np.random.default_rng(3)
+    ticks: list[list[Rangefinder]] = []
+    for k in range(int(14.0 / DT)):
+        t = k * DT
+        h = 0.25 if t < 10.0 else 1.0
+        n = 2 if k % 3 else 1
+        ticks.append([Rangefinder(t - 0.01 * (n - 1 - j), 1, h + float(rng.normal(0, 0.005)),
+                                  True, "RANGEFINDER") for j in range(n)])
+    per_reading, per_tick = KalmanEstimator(), KalmanEstimator()
+    rebases_seen = rebases_told = hidden = 0
+    for k, readings in enumerate(ticks):
+        t = k * DT
+        imu = Imu(t_s=t, sysid=1, acc_b=(0.0, 0.0, -GRAVITY_MPS2), gyro_b=(0, 0, 0),
+                  source="RAW_IMU")
+        statuses = [per_reading.update(imu if j == 0 else None, r, None, t).sonar_status
+                    for j, r in enumerate(readings)]
+        rebases_seen += SonarStatus.REACQUIRED in statuses
+        hidden += SonarStatus.REACQUIRED in statuses[:-1]  # the last reading's word hides it
+        est = per_tick.update_tick(imu, readings, None, t)
+        rebases_told += est.sonar_status is SonarStatus.REACQUIRED
+        assert est.alt_m == pytest.approx(per_reading._state()[0])
+    assert rebases_seen >= 1 and hidden >= 1 and rebases_told == rebases_seen
+    assert per_tick._state()[0] == pytest.approx(1.0, abs=0.03)
+
+
+def test_a_jump_through_a_gate_widened_by_coasting_is_a_re_base() -> None:
+    # 0.25 m over a table top, 3 s without a usable echo, then the floor 1.0 m below: the wide
+    # gate lets the first floor reading through and the estimate leaps; that tick must tell
+    # the controller it re-based (a "used" leap reads as a 0.75 m climb to be undone)
+    def sonar(t: float, h: float) -> float | None:
+        return 0.25 if t < 10.0 else None if t < 13.0 else 1.0
+
+    _, alt, recs = fly(KalmanEstimator(), hover(1.0), 15.0, sonar_fn=sonar)
+    leaps = [k for k in range(1, len(alt)) if abs(alt[k] - alt[k - 1]) >= 0.3]
+    assert leaps, "the estimate never leapt: the scene no longer tests the flag"
+    assert all(recs[k].sonar_status is SonarStatus.REACQUIRED for k in leaps)
+    assert alt[-1] == pytest.approx(1.0, abs=0.05)
+
+
 def test_tilted_hover_uses_cosine_corrected_sonar() -> None:
     truth, est, _ = fly(KalmanEstimator(), hover(1.0), 15.0, roll=0.35)
     assert rms(est[200:] - truth[200:]) < 0.01

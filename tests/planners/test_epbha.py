@@ -148,6 +148,13 @@ def test_a_vertical_keep_off_lets_a_hold_a_little_high_fly_on_under_a_table() ->
     assert p.step(START, reading(front=0.2)).reason is Reason.KEEP_OFF
 
 
+def test_a_vertical_swept_clearance_scales_vertical_offsets() -> None:
+    assert EpbhaParams().swept_z_scale == 1.0
+    assert EpbhaParams(swept_clearance_vertical_m=0.085).swept_z_scale == pytest.approx(2.0)
+    with pytest.raises(ValueError, match="swept_clearance_vertical_m"):
+        EpbhaParams(swept_clearance_vertical_m=0.0)
+
+
 def test_a_vertical_keep_off_beyond_the_sensor_range_is_refused() -> None:
     with pytest.raises(ValueError, match="keep_off_vertical_m"):
         EpbhaParams(keep_off_vertical_m=0.45)

@@ -44,6 +44,22 @@ def test_a_cone_seen_free_removes_the_cap_points_inside_it() -> None:
     assert m.segment_clearance(beside, beside) > before + 0.05
 
 
+def test_a_flat_body_counts_returns_above_farther_than_returns_beside() -> None:
+    # a table top 0.18 m over the sensors and a wall 0.18 m to the east, seen from the origin
+    over, beside = ReturnMemory(45.0, 0.5), ReturnMemory(45.0, 0.5)
+    over.add((0.0, 0.0, 0.0), reading(up=0.18))
+    beside.add((0.0, 0.0, 0.0), reading(right=0.18))
+    step = ((0.0, 0.0, 0.0), (0.1, 0.0, 0.0))
+    assert over.segment_clearance(*step) == pytest.approx(beside.segment_clearance(*step),
+                                                          abs=1e-3)
+    # semi-axes 0.17 m across and 0.085 m up: the top counts twice as far, the wall as it is
+    assert over.segment_clearance(*step, z_scale=2.0) > 0.17 > over.segment_clearance(*step)
+    assert beside.segment_clearance(*step, z_scale=2.0) == pytest.approx(
+        beside.segment_clearance(*step), abs=0.02)
+    with pytest.raises(ValueError, match="z_scale"):
+        over.segment_clearance(*step, z_scale=0.0)
+
+
 def test_returns_older_than_the_horizon_are_forgotten() -> None:
     m = ReturnMemory(45.0, 0.5, horizon=2)
     m.add((0.0, 0.0, 0.0), reading(front=0.3))
