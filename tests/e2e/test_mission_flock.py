@@ -28,12 +28,6 @@ def _states(rec: Recording) -> dict[str, float]:
 
 @pytest.mark.e2e
 @pytest.mark.timeout(420)
-@pytest.mark.xfail(strict=False, reason=(
-    "open: the root leader, flying EPBHA round and under the table between its top's keep-off "
-    "distance and the goal box's, passes within centimetres of the table and touches it in "
-    "some runs (at 2x over TCP, seed 3: 1 of 3 runs clean, 1 and 5 contacts in the others; in "
-    "lockstep, seeds 3-5: one clean, one brushing the table top, and one where the impact ran "
-    "the altitude estimate off and the mission's estimate-vs-mocap check stopped the flight)"))
 def test_five_vehicles_fly_the_flock_to_its_goals_at_2x(tmp_path: Path) -> None:
     # a fresh process, as a user runs it: the station's loops share nothing with other tests
     proc = subprocess.run(
