@@ -219,12 +219,9 @@ class AltEstimator(ABC):
         status = SonarStatus.NONE
         innovation = 0.0
         if sonar is not None:
+            tail = [z for _, z in self._rejected][-p.reacquire_count:]
             status, innovation = self._sonar(sonar, t_s, alt_before)
-            if (status is SonarStatus.USED
-                    and abs(self._state()[0] - alt_before) >= p.surface_step_m):
-                # After a long coast the gate is wide and one reading can move the estimate by
-                # a table's height (the floor past its edge): that is a re-base, not a climb,
-                # and the controller must hear it as one or it dives for the old surface.
+            if status is SonarStatus.USED and self._leapt_onto(tail, alt_before):
                 status = SonarStatus.REACQUIRED
         if at_rest and self._state()[0] < p.ground_alt_m:
             self._at_rest()
@@ -280,6 +277,24 @@ class AltEstimator(ABC):
         if rebased and est.sonar_status is not SonarStatus.REACQUIRED:
             est = replace(est, sonar_status=SonarStatus.REACQUIRED, sonar_used=True)
         return est
+
+    def _leapt_onto(self, rejected_tail: list[float], alt_before: float) -> bool:
+        """The reading just used moved the estimate a surface step onto the surface that the
+        readings rejected just before it agreed on.
+
+        Rejections of a steady surface (the floor past a table's edge) leave the filter
+        coasting and its gate wide, until one of those readings passes and moves the estimate
+        by a table's height: a re-base, not a climb, and the controller must hear it as one or
+        it dives for the surface it left. A leap after lost or late echoes (carpet) is not one:
+        it corrects a drift, a move the hold must make.
+        """
+        p = self.params
+        alt = self._state()[0]
+        if abs(alt - alt_before) < p.surface_step_m or len(rejected_tail) < p.reacquire_count:
+            return False
+        lo, hi = min(rejected_tail), max(rejected_tail)
+        return hi - lo <= p.reacquire_spread_m and lo - p.reacquire_spread_m <= alt <= (
+            hi + p.reacquire_spread_m)
 
     def _steady_far_below(self, alt_m: float) -> bool:
         """The rejected readings of late agree on a surface far below the estimate's."""

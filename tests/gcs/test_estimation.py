@@ -243,16 +243,33 @@ def test_a_re_base_on_either_reading_of_a_tick_is_the_ticks_status() -> None:
 
 
 def test_a_jump_through_a_gate_widened_by_coasting_is_a_re_base() -> None:
-    # 0.25 m over a table top, 3 s without a usable echo, then the floor 1.0 m below: the wide
-    # gate lets the first floor reading through and the estimate leaps; that tick must tell
-    # the controller it re-based (a "used" leap reads as a 0.75 m climb to be undone)
+    # 0.25 m over a table top, then past its edge the floor 1.0 m below, read through a bob
+    # too wide for the steady-reading re-base: rejected until the coasting filter's gate has
+    # widened enough, then one passes and the estimate leaps; that tick must tell the
+    # controller it re-based (a "used" leap reads as a 0.75 m climb to be undone)
     def sonar(t: float, h: float) -> float | None:
-        return 0.25 if t < 10.0 else None if t < 13.0 else 1.0
+        return 0.25 if t < 10.0 else 1.0 + 0.07 * math.sin(2.0 * math.pi * t)
 
     _, alt, recs = fly(KalmanEstimator(), hover(1.0), 15.0, sonar_fn=sonar)
     leaps = [k for k in range(1, len(alt)) if abs(alt[k] - alt[k - 1]) >= 0.3]
     assert leaps, "the estimate never leapt: the scene no longer tests the flag"
     assert all(recs[k].sonar_status is SonarStatus.REACQUIRED for k in leaps)
+    assert alt[-1] == pytest.approx(1.0, abs=0.1)
+
+
+def test_a_leap_after_lost_echoes_alone_is_a_correction() -> None:
+    # over carpet the echoes can be lost for seconds (no reading disagreed) while the
+    # accelerometer's bias shifts: the estimate drifted 0.5 m, the floor is the same floor,
+    # and the leap back is a move the hold must make
+    def sonar(t: float, h: float) -> float | None:
+        return None if 10.0 <= t < 13.0 else h
+
+    def imu_lies(t: float) -> tuple[float, float]:
+        return 1.0, 0.15 if 10.0 <= t < 13.0 else 0.0
+
+    _, alt, recs = fly(KalmanEstimator(), imu_lies, 15.0, sonar_fn=sonar)
+    assert max(abs(np.diff(alt))) >= 0.3  # it did leap
+    assert not any(r.sonar_status is SonarStatus.REACQUIRED for r in recs)
     assert alt[-1] == pytest.approx(1.0, abs=0.05)
 
 
