@@ -1,24 +1,32 @@
 """Campaigns: many seeded lockstep flights from one file, run as Ray tasks, kept as rows.
 
-`load_campaign` checks a file; `run_campaign` (grid, random) and `run_search` (Optuna TPE) fly
-it inside `ray_session`; results are Parquet rows (`read_results`), summarised by
-`summary_table` and drawn by `axis_plots`.
+`load_campaign` checks a file (`[fly]` flights or a mission file); `run_campaign` (grid, random)
+and `run_search` (Optuna TPE, flights only) fly it inside `ray_session`; results are Parquet
+rows (`read_results`), summarised by `summary_table` (`mission_summary_table`) and drawn by
+`axis_plots`.
 """
 
 from gcs.campaign.driver import Outcome, run_campaign
 from gcs.campaign.pool import ray_session
-from gcs.campaign.results import RESULTS_NAME, read_results, summary_table
+from gcs.campaign.results import (
+    RESULTS_NAME,
+    mission_summary_table,
+    read_results,
+    summary_table,
+)
 from gcs.campaign.search import BEST_NAME, SearchOutcome, run_search
-from gcs.campaign.spec import Campaign, CampaignError, load_campaign
+from gcs.campaign.spec import BaseMission, Campaign, CampaignError, load_campaign
 
 __all__ = [
     "BEST_NAME",
     "RESULTS_NAME",
+    "BaseMission",
     "Campaign",
     "CampaignError",
     "Outcome",
     "SearchOutcome",
     "load_campaign",
+    "mission_summary_table",
     "ray_session",
     "read_results",
     "run_campaign",

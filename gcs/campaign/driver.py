@@ -14,12 +14,13 @@ from pathlib import Path
 from typing import Any
 
 from gcs.campaign.metrics import OK
+from gcs.campaign.mission_run import mission_run
 from gcs.campaign.plan import plan_runs
 from gcs.campaign.pool import run_all
 from gcs.campaign.progress import Progress
 from gcs.campaign.results import RESULTS_NAME, read_results, write_results
 from gcs.campaign.run import RunSpec, fly_run
-from gcs.campaign.spec import Campaign
+from gcs.campaign.spec import BaseMission, Campaign
 
 WRITE_EVERY_S = 2.0
 
@@ -62,8 +63,11 @@ class RowKeeper:
 
 
 def run_campaign(c: Campaign, out_dir: Path, ray: Any, csv: bool = False, quiet: bool = False,
-                 runner: Callable[..., dict[str, Any]] = fly_run) -> Outcome:
-    """Fly the runs of a grid or random campaign not yet in `out_dir`'s results."""
+                 runner: Callable[..., dict[str, Any]] | None = None) -> Outcome:
+    """Fly the runs of a grid or random campaign not yet in `out_dir`'s results (each with
+    `runner`; default: `fly_run`, or `mission_run` for a mission campaign)."""
+    if runner is None:
+        runner = mission_run if isinstance(c.base, BaseMission) else fly_run
     path = out_dir / RESULTS_NAME
     rows = read_results(path)
     done = {r.get("run_id") for r in rows}

@@ -99,3 +99,37 @@ def summary_table(rows: Sequence[dict[str, Any]], axes: Sequence[str],
     widths = [max(len(row[i]) for row in lines) for i in range(len(head))]
     return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(row, widths, strict=True))
                      for row in lines)
+
+
+def mission_summary_table(rows: Sequence[dict[str, Any]], axes: Sequence[str]) -> str:
+    """Mission runs grouped by every axis but the seed: how many met their goal, the contacts
+    (over every run that measured them) and the closest pass, the flight time and goal error."""
+    group_axes = [a for a in axes if a != "seed"]
+    groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
+    for r in rows:
+        groups.setdefault(tuple(r.get(a) for a in group_axes), []).append(r)
+    head = [*group_axes, "runs", "ok", "failed", "scored", "contacts", "runs touching",
+            "clearance median cm", "closest", "flight s median", "longest", "goal error cm"]
+    lines = [head]
+    for key in sorted(groups, key=lambda k: tuple(str(x) for x in k)):
+        rs = groups[key]
+
+        def vals(col: str, rows_: list[dict[str, Any]] = rs) -> list[float]:
+            return [float(r[col]) for r in rows_ if r.get(col) is not None
+                    and math.isfinite(float(r[col]))]
+
+        def stat(xs: list[float], f: Any, scale: float = 1.0) -> str:
+            return _fmt(float(f(xs)), scale) if xs else "-"
+
+        contacts = vals("collisions")
+        ok = sum(r.get("status") == OK for r in rs)
+        lines.append([*(str(k) for k in key), str(len(rs)), str(ok), str(len(rs) - ok),
+                      str(len(contacts)), str(int(sum(contacts))),
+                      str(sum(c > 0 for c in contacts)),
+                      stat(vals("min_clearance_m"), np.median, 100.0),
+                      stat(vals("min_clearance_m"), min, 100.0),
+                      stat(vals("mission_s"), np.median), stat(vals("mission_s"), max),
+                      stat(vals("goal_error_m"), np.median, 100.0)])
+    widths = [max(len(row[i]) for row in lines) for i in range(len(head))]
+    return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(row, widths, strict=True))
+                     for row in lines)

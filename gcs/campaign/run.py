@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from gcs.campaign.metrics import failed_row, flown_row
-from gcs.campaign.spec import BaseFlight
+from gcs.campaign.spec import BaseFlight, BaseMission
 from gcs.campaign.tables import set_dotted, station_table, world_table
 from gcs.config import config_from_table
 from gcs.flight import FlightPlan
@@ -30,14 +30,14 @@ class RunSpec:
     values: dict[str, Any]
 
 
-def run_id(base: BaseFlight, values: dict[str, Any]) -> str:
+def run_id(base: BaseFlight | BaseMission, values: dict[str, Any]) -> str:
     """The same base flight and values give the same id (what resume recognises)."""
     fields = {k: str(v) for k, v in asdict(base).items() if k != "root"}
     text = json.dumps({"base": fields, "values": values}, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def make_run(base: BaseFlight, values: dict[str, Any]) -> RunSpec:
+def make_run(base: BaseFlight | BaseMission, values: dict[str, Any]) -> RunSpec:
     """A RunSpec for these values."""
     return RunSpec(run_id(base, values), dict(values))
 

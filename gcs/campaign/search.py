@@ -23,7 +23,7 @@ from gcs.campaign.pool import need, run_all
 from gcs.campaign.progress import Progress
 from gcs.campaign.results import RESULTS_NAME, read_results
 from gcs.campaign.run import RunSpec, fly_run, make_run
-from gcs.campaign.spec import Campaign, Range
+from gcs.campaign.spec import BaseFlight, Campaign, Range
 from gcs.campaign.tables import dumps, set_dotted, station_table
 from gcs.errors import RuntimeFault
 
@@ -160,6 +160,7 @@ def write_best(c: Campaign, params: dict[str, Any], value: float, path: Path,
               f"{c.search.objective} {value:.5f} (mean over seeds {list(c.search.seeds)})\n"
               + (f"flown with {flight}\n" if flight else "")
               + "quadgcs fly --config THIS_FILE")
+    config = c.base.config_path if isinstance(c.base, BaseFlight) else None  # searches fly
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(dumps(station_table(c.base.config_path, over), header), encoding="utf-8")
+    path.write_text(dumps(station_table(config, over), header), encoding="utf-8")
     return path

@@ -33,6 +33,14 @@
     objective = "rms_error_m"        # a run metric, minimised: its mean over a trial's runs
     failed_penalty = 1.0             # added to the objective per failed run
 
+A mission campaign names a mission file instead of [fly]: each run is `quadgcs mission run
+--lockstep` with one combination of its axes, the seed and any [planner] key of the mission:
+
+    mission = "../missions/epbha_table.toml"
+    [axes]
+    seed = { range = [1, 50] }
+    "planner.keep_off_vertical_m" = [0.15, 0.25]
+
 Every problem is one line naming the file, the key and what was expected (`CampaignError`).
 Values are checked here, before any run: a station key through the station's own TOML loader,
 a world key through the SITL's (`check_world`).
@@ -111,6 +119,20 @@ class BaseFlight:
 
 
 @dataclass(frozen=True, slots=True)
+class BaseMission:
+    """What every run of a mission campaign flies: the mission file, in lockstep."""
+
+    mission: str  # as the file writes it, relative to `root`
+    record: bool = False
+    root: Path = Path(".")
+
+    @property
+    def mission_path(self) -> Path:
+        """The mission file."""
+        return self.root / self.mission
+
+
+@dataclass(frozen=True, slots=True)
 class SearchSpec:
     """kind = "search": trials, the runs of one trial and what they minimise."""
 
@@ -128,7 +150,7 @@ class Campaign:
     path: Path
     name: str
     kind: str
-    base: BaseFlight
+    base: BaseFlight | BaseMission
     axes: dict[str, Axis]
     samples: int = 0
     sample_seed: int = 0
@@ -165,15 +187,16 @@ def load_campaign(path: str | Path) -> Campaign:
     name = data.get("name", p.stem)
     if not isinstance(name, str) or not name or "/" in name:
         raise _fail(p, "name", f"expected a name without '/', got {name!r}")
-    if "mission" in data:
-        _rel(p, "mission", data["mission"], "mission")
-        raise _fail(p, "mission", "mission campaigns are not flown in lockstep yet; expected "
-                    "a [fly] table")
-    base = _base(p, data.get("fly", {}))
     axes_raw = data.get("axes", {})
     if not isinstance(axes_raw, dict):
         raise _fail(p, "axes", "expected a table of axis = values")
-    axes = {k: _axis(p, base, kind, k, v) for k, v in axes_raw.items()}
+    base: BaseFlight | BaseMission
+    if "mission" in data:
+        base = _mission_base(p, data, kind)
+        axes = {k: _mission_axis(p, base, kind, k, v) for k, v in axes_raw.items()}
+    else:
+        base = _base(p, data.get("fly", {}))
+        axes = {k: _axis(p, base, kind, k, v) for k, v in axes_raw.items()}
     samples = _int(p, data, "samples", None if kind == "random" else 1, 1)
     sample_seed = _int(p, data, "sample_seed", 0, 0)
     search = _search(p, data.get("search"), kind, axes)
@@ -228,6 +251,44 @@ def _base(p: Path, fly: Any) -> BaseFlight:
             raise _fail(p, "fly.config", f"{base.config}: {exc}") from None
     _check_world(p, "fly.world", base.world_path, {})
     return base
+
+
+def _mission_base(p: Path, data: dict[str, Any], kind: str) -> BaseMission:
+    if "fly" in data:
+        raise _fail(p, "fly", "a campaign flies a mission file or a [fly] table, not both")
+    if kind == "search":
+        raise _fail(p, "kind", "a search tunes [fly] flights; a mission campaign is a grid or "
+                    "random")
+    _rel(p, "mission", data["mission"], "mission")
+    base = BaseMission(data["mission"], root=p.parent.resolve())
+    _check_mission(p, "mission", base, {})
+    return base
+
+
+def _check_mission(p: Path, key: str, base: BaseMission, planner: dict[str, Any]) -> None:
+    from gcs.campaign.mission_run import mission_with
+
+    try:
+        mission_with(base, planner)
+    except UsageError as exc:
+        raise _fail(p, key, f"{exc}") from None
+
+
+def _mission_axis(p: Path, base: BaseMission, kind: str, name: str, raw: Any) -> Axis:
+    key = f"axes.{name}"
+    axis = _values(p, key, raw, kind)
+    samples: tuple[Any, ...] = (axis.lo, axis.hi) if isinstance(axis, Range) else axis
+    for i, v in enumerate(samples):
+        at = key if isinstance(axis, Range) else f"{key}[{i}]"
+        if name == "seed":
+            if isinstance(v, bool) or not isinstance(v, int | float) or v != int(v) or v < 0:
+                raise _fail(p, at, f"expected an integer >= 0, got {v!r}")
+        elif name.startswith("planner.") and name != "planner.kind":
+            _check_mission(p, at, base, {name.removeprefix("planner."): v})
+        else:
+            raise _fail(p, key, "unknown axis; a mission campaign varies seed and planner.KEY "
+                        "(a key of the mission's [planner] table)")
+    return axis
 
 
 def _check_plan(p: Path, key: str, base: BaseFlight, over: dict[str, float]) -> None:

@@ -1,7 +1,8 @@
 """`quadgcs campaign FILE.toml`: many seeded lockstep flights from one file, on Ray.
 
 Each run is `quadgcs fly --lockstep` with the file's flight and one combination of its axes
-(station gains, estimator settings, worlds and their sensor noise, profiles, seeds), as a Ray
+(station gains, estimator settings, worlds and their sensor noise, profiles, seeds), or
+`quadgcs mission run --lockstep` with the file's mission, a seed and its planner keys, as a Ray
 task: an embedded local Ray on this machine's CPUs by default, a cluster with `--address` (or
 RAY_ADDRESS). Results: one row per run in OUTPUT/results.parquet (and .csv with --csv), a summary
 on stdout, PNG plots in OUTPUT/plots. Re-running the same file resumes: runs already in the
@@ -43,7 +44,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """CLI entry: load, fly on Ray, print the summary; 130 when interrupted."""
     from gcs.campaign import (
+        BaseMission,
         load_campaign,
+        mission_summary_table,
         ray_session,
         run_campaign,
         run_search,
@@ -67,7 +70,9 @@ def run(args: argparse.Namespace) -> int:
             outcome = run_campaign(c, out_dir, ray, csv=args.csv, quiet=args.quiet)
     axes = list(c.axes) + (["world"] if c.kind == "search" and len(c.search.worlds) > 1
                            else [])
-    print(summary_table(outcome.rows, axes))
+    missions = isinstance(c.base, BaseMission)
+    print(mission_summary_table(outcome.rows, axes) if missions
+          else summary_table(outcome.rows, axes))
     failed = sum(r.get("status") != "ok" for r in outcome.rows)
     print(f"{len(outcome.rows)} runs in {outcome.results} ({outcome.ran} flown now, "
           f"{outcome.skipped} already there, {failed} failed)")
@@ -75,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"best of {found.trials} trials: {c.search.objective} {found.best_value:.5f} "
               f"with {found.best_params}; station file {found.best_config}")
     if not args.no_plots:
-        metric = c.search.objective if c.kind == "search" else "rms_error_m"
+        metric = (c.search.objective if c.kind == "search"
+                  else "min_clearance_m" if missions else "rms_error_m")
         pics = axis_plots(outcome.rows, axes or ["seed"], metric, out_dir / "plots")
         if pics is None:
             print("plots: none drawn (matplotlib is not installed: pip install 'quadgcs[plot]')")

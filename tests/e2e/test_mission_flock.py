@@ -27,6 +27,7 @@ def _states(rec: Recording) -> dict[str, float]:
 
 
 @pytest.mark.e2e
+@pytest.mark.solo
 @pytest.mark.timeout(420)
 def test_five_vehicles_fly_the_flock_to_its_goals_at_2x(tmp_path: Path) -> None:
     # a fresh process, as a user runs it: the station's loops share nothing with other tests

@@ -18,6 +18,7 @@ pytest.importorskip("pyarrow")
 from gcs.campaign import (
     BEST_NAME,
     load_campaign,
+    mission_summary_table,
     ray_session,
     read_results,
     run_campaign,
@@ -28,6 +29,8 @@ from gcs.cli import build_parser
 from gcs.commands.fly import fly
 from gcs.config import load_config
 
+RESULTS = "results.parquet"
+
 GRID = """
 name = "grid"
 [fly]
@@ -35,6 +38,14 @@ hold_s = 2.0
 [axes]
 "station.altitude.gains.kp" = [3.0, 5.0]
 seed = [1, 2, 3]
+"""
+
+MISSION = """
+name = "epbha"
+mission = "MISSIONS/epbha_table.toml"
+[axes]
+seed = [1, 2]
+"planner.max_steps" = [400, 3]
 """
 
 SEARCH = """
@@ -96,6 +107,30 @@ def test_grid_results_resume_and_a_failing_run(tmp_path: Path, ray: Any) -> None
     assert len(rows) == 18 and len(failed) == 6
     assert all(r["station.altitude.hover_max"] == 0.3 for r in failed)
     assert all("did not happen" in r["reason"] and math.isnan(r["rms_error_m"]) for r in failed)
+
+
+@pytest.mark.timeout(240)
+def test_a_mission_campaign_scores_each_seed_against_truth(tmp_path: Path, ray: Any) -> None:
+    missions = Path(__file__).resolve().parents[2] / "missions"
+    c = load_campaign(_file(tmp_path, MISSION.replace("MISSIONS", str(missions))))
+    out = tmp_path / "out"
+    done = run_campaign(c, out, ray, quiet=True)
+    assert done.complete and done.ran == 4
+    rows = {(r["seed"], r["planner.max_steps"]): r for r in read_results(out / RESULTS)}
+    for seed in (1, 2):
+        r = rows[(seed, 400)]
+        assert r["status"] == "ok", r["reason"]
+        # the table mission's truth: reached the box, no contact, a clearance and a flight
+        assert r["error_source"] == "truth" and r["collisions"] == 0.0
+        assert 0.0 < r["min_clearance_m"] < 0.5 and r["goal_error_m"] <= 0.15
+        assert r["mission_s"] > 20.0 and r["steps"] > 10 and r["path_length_m"] > 3.0
+        # three planner steps cannot reach the box: a failed row that says why
+        short = rows[(seed, 3)]
+        assert short["status"] == "failed" and "no goal within 3 steps" in short["reason"]
+    # the seed is the SITL's: two seeds are two different flights
+    assert rows[(1, 400)]["min_clearance_m"] != rows[(2, 400)]["min_clearance_m"]
+    table = mission_summary_table(list(rows.values()), list(c.axes)).splitlines()
+    assert len(table) == 3 and "contacts" in table[0]
 
 
 @pytest.mark.timeout(240)

@@ -66,6 +66,16 @@ world = ["../../worlds/empty_room.toml"]
     ('[axes]\nseed = [1.5]', "axes.seed[0]: expected an integer >= 0, got 1.5"),
     ('[axes]\nworld = ["nowhere.toml"]', "axes.world[0]: no such world file"),
     ('mission = "no/such/mission.toml"', "mission: no such mission file"),
+    ('mission = "MISSIONS/epbha_table.toml"\n[fly]\nalt_m = 1.0',
+     "fly: a campaign flies a mission file or a [fly] table, not both"),
+    ('mission = "MISSIONS/epbha_table.toml"\nkind = "search"',
+     "kind: a search tunes [fly] flights"),
+    ('mission = "MISSIONS/epbha_table.toml"\n[axes]\nprofile = ["apm25"]',
+     "axes.profile: unknown axis; a mission campaign varies seed and planner.KEY"),
+    ('mission = "MISSIONS/epbha_table.toml"\n[axes]\n"planner.step_m" = ["long"]',
+     "axes.planner.step_m[0]: "),
+    ('mission = "MISSIONS/epbha_table.toml"\n[axes]\n"planner.wings" = [2]',
+     "axes.planner.wings[0]: "),
     ('[fly]\nalt_m = 9.0', "fly: altitude 9.0 m outside 0.2..3.5 m"),
     ('[fly]\nwind = 1', "fly.wind: unknown key; expected one of"),
     ('kind = "sweep"', "kind: expected one of ['grid', 'random', 'search'], got 'sweep'"),
@@ -82,7 +92,7 @@ world = ["../../worlds/empty_room.toml"]
     ('[axes]\n"link.jitter" = [1.0]', "axes.link.jitter: unknown axis; expected link.{loss"),
 ])
 def test_bad_files_are_one_line(tmp_path: Path, text: str, needle: str) -> None:
-    path = _file(tmp_path, text)
+    path = _file(tmp_path, text.replace("MISSIONS", str(ROOT / "missions")))
     with pytest.raises(CampaignError) as err:
         load_campaign(path)
     msg = str(err.value)

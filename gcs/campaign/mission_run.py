@@ -1,0 +1,59 @@
+"""One run of a mission campaign: `mission run --lockstep` with the run's seed and planner keys.
+
+Like `gcs.campaign.run.fly_run`, it never raises for a mission that went wrong: a refused file,
+a failed mission or a bad value is a row with its reason.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+from gcs.campaign.metrics import failed_row, mission_row
+from gcs.campaign.run import RunSpec
+from gcs.campaign.spec import BaseMission
+from gcs.mission.options import RunOptions
+from gcs.mission.planner_params import planner_setup
+from gcs.mission.spec import MissionSpec, load_mission
+
+PLANNER = "planner."
+
+
+def mission_with(base: BaseMission, planner: dict[str, Any]) -> MissionSpec:
+    """The base mission with these [planner] keys over its own, checked as the file's would be
+    (UsageError in one line)."""
+    spec = load_mission(base.mission_path)
+    if planner:
+        spec = dataclasses.replace(spec, planner_params={**spec.planner_params, **planner})
+    planner_setup(spec)
+    return spec
+
+
+def mission_run(base: BaseMission, run: RunSpec, output: Path, campaign: str) -> dict[str, Any]:
+    """Fly one run's mission in lockstep; its row (status "ok" when the goal was met)."""
+    from gcs.mission.runner import run_mission
+
+    c0, w0 = time.process_time(), time.perf_counter()
+    values = run.values
+    try:
+        planner = {k.removeprefix(PLANNER): v for k, v in values.items()
+                   if k.startswith(PLANNER)}
+        spec = mission_with(base, planner)
+        options = RunOptions(lockstep=True, record=base.record,
+                             output=output / "missions" / run.run_id,
+                             seed=int(values.get("seed", 0)))
+        report = run_mission(spec, options, None)
+        row = mission_row(run.run_id, values, report.to_dict(), report.ok)
+    except Exception as exc:  # a failed run is a row with its reason, never the campaign's end
+        text = str(exc) or type(exc).__name__
+        if type(exc).__name__ not in ("MissionFailed", "UsageError", "RuntimeFault",
+                                      "LinkError", "ParamError", "CampaignError"):
+            text = f"{type(exc).__name__}: {text}"
+        row = failed_row(run.run_id, values, text)
+    row["cpu_s"] = time.process_time() - c0
+    row["wall_s"] = time.perf_counter() - w0
+    row["worker"] = f"{os.uname().nodename}:{os.getpid()}"
+    return row
