@@ -64,8 +64,22 @@ class LockstepOptions:
     truth: bool = False
     signing_key: bytes | None = None
     # the vehicle links' faults (sitl.lockstep.LinkFaults's fields: loss, fade, fade_start_s,
-    # fade_s; seeded from `seed`), None: a clean link
+    # fade_s; seeded from `seed`; "vehicles": the sysids that suffer them, default every one),
+    # None: a clean link
     faults: dict[str, Any] | None = None
+
+
+def _faulty_sysids(given: Any, vehicles: int) -> set[int]:
+    """The sysids a fault hits: every vehicle, or those listed (each one of them)."""
+    every = set(range(1, vehicles + 1))
+    if given is None:
+        return every
+    listed = [given] if isinstance(given, int) else given
+    if (not isinstance(listed, list | tuple) or not listed
+            or not all(isinstance(v, int) and not isinstance(v, bool) for v in listed)
+            or not set(listed) <= every):
+        raise ValueError(f"faults' vehicles {given!r}: expected sysids among 1..{vehicles}")
+    return set(listed)
 
 
 class BundledLockstep:
@@ -76,15 +90,18 @@ class BundledLockstep:
         try:
             self.sitl = module.start(options.profile, options.world, options.vehicles,
                                      options.seed, options.noise, options.signing_key)
+            given = dict(options.faults or {})
+            hit = _faulty_sysids(given.pop("vehicles", None), options.vehicles)
             faults = (None if options.faults is None
-                      else module.LinkFaults(**{"seed": options.seed, **options.faults}))
+                      else module.LinkFaults(**{"seed": options.seed, **given}))
         except (ValueError, OSError, TypeError) as exc:
             where = f"--world {options.world}: " if isinstance(options.world, Path) else ""
             raise UsageError(f"{where}{exc}") from None
         self.clock = LockstepClock(self.sitl)
         self._prefix = f"lockstep{next(_instances)}"
         self._names: list[str] = []
-        self.ports = {s: self.sitl.vehicle_port(s, faults) for s in range(1, options.vehicles + 1)}
+        self.ports = {s: self.sitl.vehicle_port(s, faults if s in hit else None)
+                      for s in range(1, options.vehicles + 1)}
         self.vehicles = {s: self._plug(f"vehicle{s}", p) for s, p in self.ports.items()}
         # one motion-capture client per vehicle, as over TCP: readers of one pipe would share
         # out its bytes between them

@@ -20,6 +20,7 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+from gcs.errors import UsageError
 from gcs.mission.craft import Craft, CraftPhase
 from gcs.mission.events import EventLog, MissionEvent
 from gcs.mission.off_mission import off_mission
@@ -68,10 +69,12 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         session_options = dataclasses.replace(session_options, spin_s=0.0)
     session: StationSession
     lockstep: LockstepSession | None = None
+    if options.link_faults is not None and not options.lockstep:
+        raise UsageError("link faults are simulated in lockstep only (--lockstep)")
     if options.lockstep:
         from gcs.lockstep_session import LockstepSession
 
-        session = lockstep = LockstepSession(session_options)
+        session = lockstep = LockstepSession(session_options, faults=options.link_faults)
     else:
         session = StationSession(session_options)
     with session:

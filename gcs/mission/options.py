@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 
 @dataclass(frozen=True, slots=True)
@@ -26,3 +27,6 @@ class RunOptions:
     truth: bool = True
     # the bundled SITL in this process on simulated time (`mission run --lockstep`)
     lockstep: bool = False
+    # lockstep only: the vehicle links' faults (gcs.lockstep.LockstepOptions.faults: a fade of
+    # one way or both at a simulated time, frame loss, and which vehicles suffer them)
+    link_faults: dict[str, Any] | None = None

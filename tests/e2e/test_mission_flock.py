@@ -66,3 +66,47 @@ def test_five_vehicles_fly_the_flock_to_its_goals_at_2x(tmp_path: Path) -> None:
     events = [m["event"] for _, _, m in team.messages([EVENT])]
     assert events[:5] == ["session_ready", "arming", "armed", "taking_off", "airborne"]
     assert events.count("landed") == 5
+
+
+FADE_AT_S = 80.0  # simulated time: the team is in formation on its way to the common goal
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(300)
+def test_one_vehicles_radio_fade_ends_the_mission_safely_for_all_five(tmp_path: Path) -> None:
+    # lockstep: the five stations and the SITL on one simulated clock, vehicle 3's radio
+    # dead both ways for 10 s; the mission stops, the others land, vehicle 3's own failsafe
+    # lands it, and nobody relaunches it when its link comes back
+    from gcs.mission.options import RunOptions
+    from gcs.mission.runner import run_mission
+    from gcs.mission.spec import load_mission
+
+    fade = {"fade": "both", "fade_start_s": FADE_AT_S, "fade_s": 10.0, "vehicles": [3]}
+    report = run_mission(load_mission(MISSION), RunOptions(
+        lockstep=True, seed=3, output=tmp_path, link_faults=fade), None)
+    d = report.to_dict()
+    assert not report.ok and "vehicle 3" in d["reason"] and "link lost" in d["reason"], d
+    assert d["collision_source"] == "truth" and d["collisions"] == 0 and d["touched"] == []
+    assert len(d["recordings"]) == 5
+    for path in d["recordings"]:
+        rec = open_recording(path)
+        sysid = int(path.rsplit("vehicle", 1)[1].split(".")[0])
+        states = [(m["t_s"], m["state"]) for _, _, m in rec.messages(["/gcs/supervisor"])]
+        assert states[-1][1] == "disarmed", (sysid, states[-5:])
+        last = [m for _, _, m in rec.messages(["/vehicle/heartbeat"])][-1]
+        assert not last["armed"]
+        truth = [m for _, _, m in rec.messages(["/vehicle/sim_truth"])]
+        assert -truth[-1]["pos_n"]["z"] < 0.1  # on the floor (SITL frame: z from the start)
+        after = [m for m in truth if m["t_s"] > FADE_AT_S]
+        # every touchdown soft: nothing came down faster than a landing does
+        assert max(m["vel_n"]["z"] for m in after) < 1.0, sysid
+        if sysid == 3:
+            # link lost, then silence; when it is back the vehicle is the firmware's (LAND)
+            # and the station never takes it back up
+            names = [s for _, s in states]
+            lost = names.index("link_lost")
+            assert not {"takeoff", "hold", "spool_up"} & set(names[lost:]), states
+        else:
+            # the others were landed by the mission once vehicle 3 was gone
+            landing = next(t for t, s in states if s == "vehicle")
+            assert landing > FADE_AT_S

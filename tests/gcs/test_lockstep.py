@@ -84,3 +84,36 @@ def test_lockstep_refuses_what_it_cannot_fly(flag: list[str],
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert err.startswith(f"quadgcs fly: --lockstep: {flag[0]} cannot be used with it")
+
+
+def test_a_fault_hits_only_the_vehicles_it_names() -> None:
+    from gcs.errors import UsageError
+    from gcs.lockstep import BundledLockstep, LockstepOptions
+
+    sim = BundledLockstep(LockstepOptions(vehicles=2, faults={
+        "fade": "down", "fade_start_s": 0.0, "fade_s": 100.0, "vehicles": [2]}))
+    try:
+        for port in sim.ports.values():
+            port.connect()
+        sim.sitl.advance_to(3.0)
+        assert sim.ports[1].lost_frames == (0, 0) and sim.ports[1].read(1 << 20)
+        assert sim.ports[2].lost_frames[0] > 0 and not sim.ports[2].read(1 << 20)
+    finally:
+        sim.close()
+    for bad in ([3], [], "two", [True]):
+        with pytest.raises(UsageError, match="faults' vehicles") as err:
+            BundledLockstep(LockstepOptions(vehicles=2, faults={"fade": "both",
+                                                                "vehicles": bad}))
+        assert "\n" not in str(err.value)
+
+
+def test_link_faults_are_refused_off_lockstep(tmp_path: Path) -> None:
+    from gcs.errors import UsageError
+    from gcs.mission.options import RunOptions
+    from gcs.mission.runner import run_mission
+    from gcs.mission.spec import load_mission
+
+    mission = Path(__file__).resolve().parents[2] / "missions" / "epbha_table.toml"
+    with pytest.raises(UsageError, match="lockstep only"):
+        run_mission(load_mission(mission), RunOptions(output=tmp_path, link_faults={
+            "fade": "both"}), None)
