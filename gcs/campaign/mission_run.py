@@ -7,13 +7,12 @@ a failed mission or a bad value is a row with its reason.
 from __future__ import annotations
 
 import dataclasses
-import os
 import time
 from pathlib import Path
 from typing import Any
 
 from gcs.campaign.metrics import failed_row, mission_row
-from gcs.campaign.run import RunSpec
+from gcs.campaign.run import RunSpec, failure_text, stamped
 from gcs.campaign.spec import BaseMission
 from gcs.mission.options import RunOptions
 from gcs.mission.planner_params import planner_setup
@@ -48,12 +47,5 @@ def mission_run(base: BaseMission, run: RunSpec, output: Path, campaign: str) ->
         report = run_mission(spec, options, None)
         row = mission_row(run.run_id, values, report.to_dict(), report.ok)
     except Exception as exc:  # a failed run is a row with its reason, never the campaign's end
-        text = str(exc) or type(exc).__name__
-        if type(exc).__name__ not in ("MissionFailed", "UsageError", "RuntimeFault",
-                                      "LinkError", "ParamError", "CampaignError"):
-            text = f"{type(exc).__name__}: {text}"
-        row = failed_row(run.run_id, values, text)
-    row["cpu_s"] = time.process_time() - c0
-    row["wall_s"] = time.perf_counter() - w0
-    row["worker"] = f"{os.uname().nodename}:{os.getpid()}"
-    return row
+        row = failed_row(run.run_id, values, failure_text(exc))
+    return stamped(row, c0, w0)

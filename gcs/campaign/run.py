@@ -88,11 +88,23 @@ def fly_run(base: BaseFlight, run: RunSpec, output: Path, campaign: str) -> dict
         row = flown_row(run.run_id, values, summary)
         row["sim_s"] = sim_s
     except Exception as exc:  # a failed run is a row with its reason, never the campaign's end
-        text = str(exc) or type(exc).__name__
-        if type(exc).__name__ not in ("FlightFailed", "UsageError", "RuntimeFault", "LinkError",
-                                      "ParamError", "CampaignError"):
-            text = f"{type(exc).__name__}: {text}"
-        row = failed_row(run.run_id, values, text)
+        row = failed_row(run.run_id, values, failure_text(exc))
+    return stamped(row, c0, w0)
+
+
+# errors whose text says what went wrong; any other gets its type's name in front
+_SPOKEN = ("FlightFailed", "MissionFailed", "UsageError", "RuntimeFault", "LinkError",
+           "ParamError", "CampaignError")
+
+
+def failure_text(exc: Exception) -> str:
+    """A failed run's reason, as one line."""
+    text = str(exc) or type(exc).__name__
+    return text if type(exc).__name__ in _SPOKEN else f"{type(exc).__name__}: {text}"
+
+
+def stamped(row: dict[str, Any], c0: float, w0: float) -> dict[str, Any]:
+    """The row with the run's CPU and wall time since (c0, w0) and the worker that ran it."""
     row["cpu_s"] = time.process_time() - c0
     row["wall_s"] = time.perf_counter() - w0
     row["worker"] = f"{os.uname().nodename}:{os.getpid()}"

@@ -274,15 +274,25 @@ def _check_mission(p: Path, key: str, base: BaseMission, planner: dict[str, Any]
         raise _fail(p, key, f"{exc}") from None
 
 
+def _samples(p: Path, key: str, raw: Any, kind: str) -> tuple[Axis, list[tuple[str, Any]]]:
+    """An axis and the values to check of it, each with where it is in the file."""
+    axis = _values(p, key, raw, kind)
+    if isinstance(axis, Range):
+        return axis, [(key, axis.lo), (key, axis.hi)]
+    return axis, [(f"{key}[{i}]", v) for i, v in enumerate(axis)]
+
+
+def _check_seed(p: Path, at: str, v: Any) -> None:
+    if isinstance(v, bool) or not isinstance(v, int | float) or v != int(v) or v < 0:
+        raise _fail(p, at, f"expected an integer >= 0, got {v!r}")
+
+
 def _mission_axis(p: Path, base: BaseMission, kind: str, name: str, raw: Any) -> Axis:
     key = f"axes.{name}"
-    axis = _values(p, key, raw, kind)
-    samples: tuple[Any, ...] = (axis.lo, axis.hi) if isinstance(axis, Range) else axis
-    for i, v in enumerate(samples):
-        at = key if isinstance(axis, Range) else f"{key}[{i}]"
+    axis, samples = _samples(p, key, raw, kind)
+    for at, v in samples:
         if name == "seed":
-            if isinstance(v, bool) or not isinstance(v, int | float) or v != int(v) or v < 0:
-                raise _fail(p, at, f"expected an integer >= 0, got {v!r}")
+            _check_seed(p, at, v)
         elif name.startswith("planner.") and name != "planner.kind":
             _check_mission(p, at, base, {name.removeprefix("planner."): v})
         else:
@@ -335,13 +345,10 @@ def _values(p: Path, key: str, raw: Any, kind: str) -> Axis:
 
 def _axis(p: Path, base: BaseFlight, kind: str, name: str, raw: Any) -> Axis:
     key = f"axes.{name}"
-    axis = _values(p, key, raw, kind)
-    samples: tuple[Any, ...] = (axis.lo, axis.hi) if isinstance(axis, Range) else axis
-    for i, v in enumerate(samples):
-        at = key if isinstance(axis, Range) else f"{key}[{i}]"
+    axis, samples = _samples(p, key, raw, kind)
+    for at, v in samples:
         if name == "seed":
-            if isinstance(v, bool) or not isinstance(v, int | float) or v != int(v) or v < 0:
-                raise _fail(p, at, f"expected an integer >= 0, got {v!r}")
+            _check_seed(p, at, v)
         elif name == "profile":
             if v not in PROFILES:
                 raise _fail(p, at, f"expected one of {list(PROFILES)}, got {v!r}")
