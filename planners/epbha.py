@@ -284,16 +284,18 @@ class Epbha:
             self._deadlocked = True
             return self._hover(pos, Reason.DEADLOCK_LOOP, options)
 
-        if self._manoeuvre is not None:
-            decision = self._continue_manoeuvre(pos, reading, options)
-            if decision is not None:
-                return decision
-
+        # Nearer than keep-off comes first, in a manoeuvre too: passing alongside a table
+        # leg the manoeuvre would fly on within the body's radius of it.
         keep_off = self._keep_off(pos, reading)
         if keep_off is not None:
             self._recoiled_from = keep_off.opposite
             return self._decide(self._neighbour(pos, keep_off), Status.MOVING, Reason.KEEP_OFF,
                                 ObstacleClass.NONE, (), options)
+
+        if self._manoeuvre is not None:
+            decision = self._continue_manoeuvre(pos, reading, options)
+            if decision is not None:
+                return decision
 
         # Just backed away from something on that side: going straight back would only
         # oscillate, so that side counts as blocked once and the obstacle gets classified.
