@@ -31,6 +31,10 @@ from gcs.config import load_config
 
 RESULTS = "results.parquet"
 
+# Two Ray workers flying lockstep runs take both cores: a wall-clock flight beside them on the
+# other test process loses its ticks (make test runs `solo` tests alone)
+pytestmark = pytest.mark.solo
+
 GRID = """
 name = "grid"
 [fly]
