@@ -219,7 +219,12 @@ class AltEstimator(ABC):
         status = SonarStatus.NONE
         innovation = 0.0
         if sonar is not None:
-            tail = [z for _, z in self._rejected][-p.reacquire_count:]
+            # only after a rejection run as long as the steady-reading re-base asks for: in a
+            # climb a short run of rejected readings can agree too, and re-basing on a move
+            # would leave the hold displaced by it
+            long_run = bool(self._rejected) and (
+                t_s - self._reject_run_start_s >= p.reacquire_min_s)
+            tail = [z for _, z in self._rejected][-p.reacquire_count:] if long_run else []
             status, innovation = self._sonar(sonar, t_s, alt_before)
             if status is SonarStatus.USED and self._leapt_onto(tail, alt_before):
                 status = SonarStatus.REACQUIRED
