@@ -42,6 +42,13 @@ SUBPROTOCOL = "foxglove.sdk.v1"
 YIELD_AFTER_S = 0.0002  # worker time slice before it hands the GIL back to the loop
 WAKE_EVERY_S = 0.05
 DISPLAY_TF_EVERY_S = 1.0  # a client that joins late still gets the world → ned transform
+# Per client, the server drops its oldest data message once this many wait to go out. The SDK's
+# 1024 is about 2 s of a flight's subscribed topics at replay speed 2: a viewer on a busy PC
+# stalls that long and loses the middle of a flight. Messages are a few hundred bytes each.
+BACKLOG_MESSAGES = 16_384
+# The SDK has no flush: stopping the server drops what its sender tasks still hold, the last
+# messages of a replay. Closing waits this long for them while a client is subscribed.
+CLOSE_LINGER_S = 0.5
 RAW_FRAME_SCHEMA_NAME = "quadgcs.MavlinkFrame"
 _RAW_SCHEMA: dict[str, Any] = {
     "type": "object",
@@ -94,7 +101,8 @@ class LiveView:
         self._context = foxglove.Context()  # own channels: several views may share a process
         try:
             self._server = foxglove.start_server(name=name, host=host, port=port,
-                                                 context=self._context)
+                                                 context=self._context,
+                                                 message_backlog_size=BACKLOG_MESSAGES)
         except Exception as exc:  # the SDK raises its own error type for a busy or bad address
             raise RecordingError(f"--foxglove {host}:{port}: cannot serve: {exc}") from None
         self.host = host
@@ -183,6 +191,8 @@ class LiveView:
         self._closing = True
         self._wake.set()
         self._thread.join()
+        if any(channel.has_sinks() for channel in self._channels.values()):
+            time.sleep(CLOSE_LINGER_S)
         for channel in self._channels.values():
             channel.close()
         self._server.stop()
