@@ -285,7 +285,10 @@ class Station(StationIntents):
         """The loop crashed: ask for LAND (hover throttle, level) until a heartbeat shows it."""
         if self.supervisor.state not in AIRBORNE_CAPABLE:
             return
-        hb = emergency_land(self.link, self.alt_ctrl.hover_stick_us(), self.config.period_s)
+        est = self._estimate
+        throttle = (self.supervisor.safe_throttle_us(est.alt_m) if est is not None
+                    else STICK_MIN_US)
+        hb = emergency_land(self.link, throttle, self.config.period_s)
         if isinstance(hb, Heartbeat):
             self._latest[Heartbeat] = hb
         elif hb:

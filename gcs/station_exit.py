@@ -31,11 +31,12 @@ def let_go(link: Any, state: SupervisorState, hb: Heartbeat | None) -> str:
             "own failsafe takes over")
 
 
-def emergency_land(link: Any, hover_us: int, period_s: float,
+def emergency_land(link: Any, throttle_us: int, period_s: float,
                    seconds: float = EMERGENCY_LAND_S) -> Heartbeat | str | None:
-    """SET_MODE LAND every half second with hover throttle, level, until a heartbeat shows LAND
-    or disarmed (returned), the time is up (None) or the link fails (its error text)."""
-    hover = RcCommand(1500, 1500, hover_us, 1500)
+    """SET_MODE LAND every half second with `throttle_us` (the supervisor's safe throttle:
+    hover aloft, minimum on the floor), level, until a heartbeat shows LAND or disarmed
+    (returned), the time is up (None) or the link fails (its error text)."""
+    hover = RcCommand(1500, 1500, throttle_us, 1500)
     end = time.monotonic() + seconds
     next_mode = 0.0
     try:

@@ -88,6 +88,7 @@ class Supervisor:
         self._armed_at_s = -math.inf
         self._kill_at_s = -math.inf
         self._lost_at_s = -math.inf
+        self._lost_throttle_us = STICK_MIN_US  # chosen when the link was lost, held through it
         self._next_send_s = -math.inf
         self._ramp_us = 0.0
         self._ramp_top_since_s: float | None = None
@@ -272,6 +273,7 @@ class Supervisor:
         if self._link is not LinkHealth.LOST or self.state not in AIRBORNE_CAPABLE:
             return
         self._lost_at_s = self._t
+        self._lost_throttle_us = self.safe_throttle_us(inp.estimate.alt_m)
         self._end_pc_control()
         self._go(S.LINK_LOST, f"nothing heard from the vehicle for "
                  f"{inp.vehicle.frame_age_s:.1f} s: commanding LAND", Level.ERROR)
@@ -360,7 +362,7 @@ class Supervisor:
                          "vehicle's own failsafe lands it", Level.ERROR)
                 return None, False
             self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
-            return self._safe_hold(), True
+            return self._safe_hold(self._lost_throttle_us), True
         if st is S.SILENT:
             return None, False
         if st is S.VEHICLE:
@@ -381,9 +383,21 @@ class Supervisor:
             return self._takeoff(inp), True
         return self._hold(inp), True
 
-    def _safe_hold(self) -> RcCommand:
-        """A silent vehicle gets hover throttle, level, no yaw: no climb, no chase."""
-        return RcCommand(STICK_MID_US, STICK_MID_US, self.alt_ctrl.hover_stick_us(), STICK_MID_US)
+    def safe_throttle_us(self, alt_m: float) -> int:
+        """The throttle for a vehicle that cannot be heard (or a loop that died): hover where it
+        flies, so it neither climbs nor falls; minimum on the floor, where hover throttle would
+        lift it (3.2.1's THR_MID is 1500 us); never above the pilot's own stick in MANUAL."""
+        if self.on_floor(alt_m):
+            return STICK_MIN_US
+        hover = self.alt_ctrl.hover_stick_us()
+        if self.state is S.MANUAL:
+            return min(hover, self.sticks.throttle_us if self.gate_us is None else self.gate_us)
+        return hover
+
+    @staticmethod
+    def _safe_hold(throttle_us: int) -> RcCommand:
+        """Level, no yaw: no chase."""
+        return RcCommand(STICK_MID_US, STICK_MID_US, throttle_us, STICK_MID_US)
 
     def _manual(self) -> RcCommand:
         s = self.sticks
@@ -434,7 +448,7 @@ class Supervisor:
     def _hold(self, inp: TickIn) -> RcCommand:
         if self._link is LinkHealth.DEGRADED:
             if self._frozen is None:
-                self._frozen = self._safe_hold()
+                self._frozen = self._safe_hold(self.safe_throttle_us(inp.estimate.alt_m))
                 self._note(Level.WARNING, "telemetry gap: holding hover throttle, level")
             return self._frozen
         if self._frozen is not None:

@@ -266,6 +266,8 @@ def test_a_crash_with_the_vehicle_armed_asks_for_land_before_letting_go() -> Non
     assert not st.running and isinstance(st.error, ZeroDivisionError)
     assert FlightMode.LAND in board.modes and board.mode == FlightMode.LAND
     assert board.released == 1  # only once LAND was seen
+    # on the floor the emergency LAND keeps the throttle at minimum: hover would lift it
+    assert board.overrides and max(c.throttle_us for c in board.overrides) == 1000
 
 
 def test_link_events_become_station_events() -> None:

@@ -178,6 +178,49 @@ def test_short_gap_holds_hover_throttle_level_then_hold_resumes() -> None:
     assert out.link is LinkHealth.OK and s.sup.state is S.HOLD and s.sup.alt is not None
 
 
+@pytest.mark.parametrize("dialect", [Dialect.APM25, Dialect.COPTER4])
+def test_link_lost_while_armed_on_the_floor_keeps_the_throttle_at_minimum(
+        dialect: Dialect) -> None:
+    # 3.2.1's hover stick is THR_MID, 1500 us: sent to an armed vehicle on the floor, it lifts
+    s = Script(dialect)
+    s.armed_in_stabilize()
+    s.run(1.0)
+    assert s.sup.alt_ctrl.hover_stick_us() > 1300
+    s.down = False
+    outs = s.run(3.0)
+    assert s.sup.state is S.LINK_LOST
+    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
+    assert actions(outs, ActionKind.SET_MODE)  # LAND is still asked: on the floor it disarms
+
+
+def test_link_lost_in_manual_flight_never_raises_the_pilots_throttle() -> None:
+    s = Script()
+    s.armed_in_stabilize()
+    s.tick(Intent(IntentKind.STICKS, throttle_us=1000))
+    s.tick(Intent(IntentKind.STICKS, throttle_us=1350))  # descending, below hover
+    s.alt = 1.2
+    s.run(0.5)
+    hover = s.sup.alt_ctrl.hover_stick_us()
+    assert hover > 1350
+    s.down = False
+    outs = s.run(2.0)
+    assert s.sup.state is S.LINK_LOST
+    assert all(o.command is not None and o.command.throttle_us <= 1350 for o in outs)
+
+
+def test_hover_throttle_held_through_a_gap_in_flight() -> None:
+    s = Script()
+    s.hovering()
+    s.run(1.0)
+    hover = s.sup.alt_ctrl.hover_stick_us()
+    s.down = False
+    outs = s.run(2.0)
+    assert s.sup.state is S.LINK_LOST
+    lost = [o for o in outs if o.state is S.LINK_LOST]
+    assert lost and all(o.command is not None and abs(o.command.throttle_us - hover) <= 3
+                        for o in lost)
+
+
 def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
     s = Script()
     s.hovering()
