@@ -16,6 +16,7 @@ from gcs.mission.planner_params import planner_setup
 from gcs.mission.spec import load_mission
 from gcs.mission.world import load_world
 from logs import open_recording
+from tests.e2e.sitl_proc import SitlProcess
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -55,14 +56,13 @@ def test_a_short_mapping_flight_samples_the_sitl_field(tmp_path: Path) -> None:
 
 
 @pytest.mark.e2e
+@pytest.mark.solo  # a wall-clock flight at 2x: bursts of a starved SITL would blur its samples
 @pytest.mark.timeout(240)
-@pytest.mark.skip(reason="the SITL's battery failsafe is now off by default, as on the real "
-                  "firmwares (FS_BATT_ENABLE 0 / BATT_FS_LOW_ACT 0), so this flight maps to the "
-                  "end instead (159 s); it needs a world that turns the failsafe on")
 def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
         tmp_path: Path) -> None:
     # A small pack: the autopilot's battery failsafe switches to LAND within a minute of flight.
-    # The mission must stop there and say why, not take floor readings as mapped ones.
+    # The mission must stop there and say why, not take floor readings as mapped ones. Both
+    # firmwares ship with the battery failsafe off; the pilot turns it on, as on a real vehicle.
     world_text, n = re.subn(r"(?m)^battery_capacity_mah = .*$", "battery_capacity_mah = 300.0",
                             (ROOT / "worlds" / "radiation_3src.toml").read_text())
     assert n == 1
@@ -72,10 +72,22 @@ def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
     text = re.sub(r'(?m)^world = .*$', f'world = "{world}"', text)
     mission = tmp_path / "small_pack_mission.toml"
     mission.write_text(text)
-    proc = subprocess.run(
-        [sys.executable, "-m", "gcs", "mission", "run", str(mission), "--speedup", "4",
-         "--seed", "5", "--json", "-o", str(tmp_path), "--plot", str(tmp_path / "p.png")],
-        capture_output=True, text=True, timeout=200, check=False)
+    sitl = SitlProcess(["--tcp", "0", "--world", str(world), "--speedup", "2", "--seed", "5",
+                        "--mocap-port", "0"], ROOT)
+    try:
+        url = "tcp:" + sitl.endpoint(1, "tcp")
+        mocap = next(line.split()[1] for line in sitl.lines if line.startswith("mocap "))
+        on = subprocess.run([sys.executable, "-m", "gcs", "params", "--connect", url, "set",
+                             "FS_BATT_ENABLE", "1"], capture_output=True, text=True,
+                            timeout=120, check=False, cwd=ROOT)
+        assert on.returncode == 0, on.stderr
+        proc = subprocess.run(
+            [sys.executable, "-m", "gcs", "mission", "run", str(mission), "--connect", url,
+             "--mocap", mocap, "--speedup", "2", "--json",
+             "-o", str(tmp_path), "--plot", str(tmp_path / "p.png")],
+            capture_output=True, text=True, timeout=200, check=False, cwd=ROOT)
+    finally:
+        sitl.stop()
     out = proc.stdout.strip().splitlines()
     assert out, f"exit {proc.returncode}: {proc.stderr.strip()}"
     d = json.loads(out[-1])
