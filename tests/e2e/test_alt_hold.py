@@ -30,8 +30,8 @@ def fly_json(*argv: str) -> dict[str, Any]:
 @pytest.mark.parametrize("transport", [
     # Alone: a SITL starved of CPU falls behind and then sends 0.2 s of telemetry at once; the
     # estimator takes one averaged IMU sample per tick and no acceleration once it is 60 ms
-    # old, so such bursts leave the estimate 0.3 m behind a 1 m step (overshoot 16-52 % on
-    # five flights beside three busy processes on two cores; 3-7 % on an idle machine). Open.
+    # old, so such bursts leave the estimate 0.3 m behind a 1 m step (overshoot 16-52 % with
+    # five flights at once beside three busy processes on two cores; 3-7 % with three). Open.
     pytest.param("tcp", marks=pytest.mark.solo),
     pytest.param("serial", marks=pytest.mark.xfail(
         strict=False, reason="on 115200 baud ArduCopter 3.2.1 streams at 50/N Hz (16.7 Hz "
