@@ -282,7 +282,8 @@ class Station(StationIntents):
             self._event(self.clock.now_s(), EventLevel.ERROR, text)
 
     def _emergency_land(self) -> None:
-        """The loop crashed: ask for LAND (hover throttle, level) until a heartbeat shows it."""
+        """The loop crashed: ask for LAND (the supervisor's safe throttle, level) until a
+        heartbeat shows it."""
         if self.supervisor.state not in AIRBORNE_CAPABLE:
             return
         est = self._estimate

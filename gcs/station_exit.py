@@ -36,7 +36,7 @@ def emergency_land(link: Any, throttle_us: int, period_s: float,
     """SET_MODE LAND every half second with `throttle_us` (the supervisor's safe throttle:
     hover aloft, minimum on the floor), level, until a heartbeat shows LAND or disarmed
     (returned), the time is up (None) or the link fails (its error text)."""
-    hover = RcCommand(1500, 1500, throttle_us, 1500)
+    command = RcCommand(1500, 1500, throttle_us, 1500)
     end = time.monotonic() + seconds
     next_mode = 0.0
     try:
@@ -47,7 +47,7 @@ def emergency_land(link: Any, throttle_us: int, period_s: float,
             if time.monotonic() >= next_mode:
                 link.send_set_mode(FlightMode.LAND)
                 next_mode = time.monotonic() + MODE_RESEND_S
-            link.rc_override(hover)
+            link.rc_override(command)
             time.sleep(period_s)  # a dead loop paces itself: there is no clock to wait on
     except Exception as exc:
         return str(exc) or type(exc).__name__

@@ -46,8 +46,8 @@ DISPLAY_TF_EVERY_S = 1.0  # a client that joins late still gets the world → ne
 # 1024 is about 2 s of a flight's subscribed topics at replay speed 2: a viewer on a busy PC
 # stalls that long and loses the middle of a flight. Messages are a few hundred bytes each.
 BACKLOG_MESSAGES = 16_384
-# The SDK has no flush: stopping the server drops what its sender tasks still hold, the last
-# messages of a replay. Closing waits this long for them while a client is subscribed.
+# The SDK has no flush, and a client of a finished replay was seen to miss its last messages.
+# Closing waits this long for the server's senders while a client is subscribed.
 CLOSE_LINGER_S = 0.5
 RAW_FRAME_SCHEMA_NAME = "quadgcs.MavlinkFrame"
 _RAW_SCHEMA: dict[str, Any] = {

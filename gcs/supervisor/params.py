@@ -4,10 +4,10 @@ Link-loss policy (the same decision in both dialects; what differs is how the fi
 behaves, which the pre-flight checks make safe):
 
 - Proof of life is any frame from the vehicle. A gap over `degraded_after_s` holds a safe
-  command (hover throttle, level) and freezes the altitude controller; the controller resumes
-  when frames come back.
+  command (hover throttle, level; minimum on the floor) and freezes the altitude controller;
+  the controller resumes when frames come back.
 - A gap over `lost_after_s` lands the vehicle: SET_MODE LAND every `mode_resend_s` for
-  `land_request_s` while the uplink may still work, with the hover throttle in the overrides.
+  `land_request_s` while the uplink may still work, with that safe throttle in the overrides.
 - Still nothing heard after that: the station goes silent (no overrides, no heartbeats), so the
   autopilot's own GCS failsafe fires whatever the state of the uplink. ArduCopter 3.2.1 fires it
   5 s after the last heartbeat or override (and its radio failsafe 2 s after the last override

@@ -449,7 +449,8 @@ class Supervisor:
         if self._link is LinkHealth.DEGRADED:
             if self._frozen is None:
                 self._frozen = self._safe_hold(self.safe_throttle_us(inp.estimate.alt_m))
-                self._note(Level.WARNING, "telemetry gap: holding hover throttle, level")
+                self._note(Level.WARNING, f"telemetry gap: throttle held at "
+                           f"{self._frozen.throttle_us} us, level")
             return self._frozen
         if self._frozen is not None:
             self._frozen = None

@@ -34,8 +34,9 @@ def fly_json(*argv: str) -> dict[str, Any]:
     # five flights at once beside three busy processes on two cores; 3-7 % with three). Open.
     pytest.param("tcp", marks=pytest.mark.solo),
     pytest.param("serial", marks=pytest.mark.xfail(
-        strict=False, reason="on 115200 baud ArduCopter 3.2.1 streams at 50/N Hz (16.7 Hz "
-        "within the byte budget), and the 1 m step settles in about 4.8 s, not 4 s (open)")),
+        strict=False, reason="a 115200-baud line carries the telemetry at 16.7 Hz (3.2.1 "
+        "streams at 50/N Hz within the byte budget), and the 1 m step settles in about 4.8 s, "
+        "not 4 s (open)")),
 ])
 def test_holds_1m_and_settles_a_1m_step(transport: str, profile: str) -> None:
     """Over TCP, and over the product's own case: an APM 2.5 (or a 4.x board) on a 115200-baud

@@ -208,27 +208,18 @@ def test_link_lost_in_manual_flight_never_raises_the_pilots_throttle() -> None:
     assert all(o.command is not None and o.command.throttle_us <= 1350 for o in outs)
 
 
-def test_hover_throttle_held_through_a_gap_in_flight() -> None:
+def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
     s = Script()
     s.hovering()
     s.run(1.0)
     hover = s.sup.alt_ctrl.hover_stick_us()
     s.down = False
-    outs = s.run(2.0)
-    assert s.sup.state is S.LINK_LOST
-    lost = [o for o in outs if o.state is S.LINK_LOST]
-    assert lost and all(o.command is not None and abs(o.command.throttle_us - hover) <= 3
-                        for o in lost)
-
-
-def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
-    s = Script()
-    s.hovering()
-    s.run(1.0)
-    s.down = False
     outs = s.run(1.6)
     assert s.sup.state is S.LINK_LOST
     outs += s.run(2.9)
+    lost = [o for o in outs if o.state is S.LINK_LOST]  # in the air: hover, no climb, no fall
+    assert lost and all(o.command is not None and abs(o.command.throttle_us - hover) <= 3
+                        for o in lost)
     lands = actions(outs, ActionKind.SET_MODE)
     assert lands and all(m == FlightMode.LAND for m in lands)
     assert len(lands) >= 5  # every 0.5 s while the uplink may work
