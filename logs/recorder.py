@@ -5,6 +5,11 @@ a 25 ms control tick pays well under a millisecond for recording. The writer thr
 payloads, writes zstd chunks and flushes at least every `flush_interval_s`, so a process killed
 with SIGKILL loses at most its last interval. A full queue drops and counts, never silently.
 
+A simulated-time producer (`block_when_full`: a lockstep flight) has no tick deadline to protect
+and must lose nothing: it writes its own queue, in batches and at least every interval, on its
+own thread. A writer thread would only contend with it for the GIL, which cost a lockstep flight
+more CPU than the writing itself.
+
 Time: records carry the station's monotonic `t_s`; log times are nanoseconds on a UTC-anchored
 timeline, `anchor_ns + t_s·1e9`, with `anchor_ns = wall clock − monotonic clock` taken once at
 start, so the file's times read as UTC yet never jump when the wall clock is adjusted.
@@ -42,6 +47,7 @@ from logs.topics import LOG_TOPIC, MAVLINK_RX_TOPIC, MAVLINK_TX_TOPIC, TF_TOPIC
 
 DEFAULT_DIR = Path("flights")
 YIELD_AFTER_S = 0.0002  # writer time slice before it lets other threads run
+INLINE_BATCH = 4096  # a simulated-time producer writes its queue once this many records wait
 METADATA_NAME = "quadgcs.flight"
 RAW_FRAME_SCHEMA_NAME = "quadgcs.MavlinkFrame"
 RAW_FRAME_SCHEMA: dict[str, Any] = {
@@ -204,9 +210,9 @@ class Recorder:
         # simulated-time producer (a lockstep flight, far faster than real time) waits for the
         # writer instead: nothing it records is lost.
         self._block = bool(block_when_full)
+        self._batch = max(1, min(self._max_queue, INLINE_BATCH))
         self._queue: deque[tuple[_Kind, str, float, Any]] = deque()
         self._wake = threading.Event()
-        self._drained = threading.Event()  # the writer took a slice off the queue
         self._closing = False
         self._closed = False
         self._drop_lock = threading.Lock()
@@ -230,10 +236,13 @@ class Recorder:
         self._topic_schemas: dict[str, tuple[str, Mapping[str, Any]]] = {}
         self._last_log_ns: int | None = None
         self._reported_drops = 0
-        self._thread = threading.Thread(
-            target=self._run, name=f"recorder-{vehicle}", daemon=True
-        )
-        self._thread.start()
+        self._next_flush = time.monotonic() + self._flush_interval_s
+        self._thread: threading.Thread | None = None
+        if not self._block:
+            self._thread = threading.Thread(
+                target=self._run, name=f"recorder-{vehicle}", daemon=True
+            )
+            self._thread.start()
         atexit.register(self.close)
 
     @property
@@ -262,7 +271,8 @@ class Recorder:
             error=self._error,
         )
 
-    # The four calls below run on the station's loop thread: queue only, never block.
+    # The four calls below run on the producer's thread: queue only, never block (a simulated-time
+    # producer writes its own batches, see the module docstring).
 
     def put(self, topic: str, t_s: float, payload: Any) -> None:
         """Queue a record (dataclass, dict or FoxgloveMessage) on `topic` at monotonic `t_s`."""
@@ -287,17 +297,29 @@ class Recorder:
         self._enqueue(_Kind.METADATA, name, 0.0, dict(data))
 
     def _enqueue(self, kind: _Kind, topic: str, t_s: float, payload: Any) -> None:
-        if self._block:
-            while (len(self._queue) >= self._max_queue and not self._closing
-                   and self._error is None and self._thread.is_alive()):
-                self._drained.clear()
-                self._wake.set()
-                self._drained.wait(0.1)
-        if self._closing or len(self._queue) >= self._max_queue:
+        if self._closing or (not self._block and len(self._queue) >= self._max_queue):
             with self._drop_lock:
                 self._dropped[topic] = self._dropped.get(topic, 0) + 1
             return
         self._queue.append((kind, topic, t_s, payload))
+        if self._block and (len(self._queue) >= self._batch
+                            or time.monotonic() >= self._next_flush):
+            self._write_queued()
+
+    def _write_queued(self) -> None:
+        """A simulated-time producer's own writing: the whole queue, then a flush when due."""
+        queue = self._queue
+        while queue:
+            item = queue.popleft()
+            if self._error is None:
+                self._write_item(*item)
+            else:
+                with self._drop_lock:
+                    self._dropped[item[1]] = self._dropped.get(item[1], 0) + 1
+        now = time.monotonic()
+        if now >= self._next_flush:
+            self._flush()
+            self._next_flush = now + self._flush_interval_s
 
     def close(self) -> None:
         """Drain the queue, write the summary and index, close the file. Idempotent."""
@@ -307,7 +329,10 @@ class Recorder:
         self._closing = True
         atexit.unregister(self.close)
         self._wake.set()
-        self._thread.join()
+        if self._thread is not None:
+            self._thread.join()
+        else:
+            self._write_queued()
         try:
             if self._error is None:
                 self._note_drops()
@@ -343,10 +368,8 @@ class Recorder:
                 if time.perf_counter() > slice_end:
                     # Hand the GIL over: a loop thread waiting for it would otherwise wait for
                     # the interpreter's switch interval (5 ms), a fifth of a control tick.
-                    self._drained.set()
                     time.sleep(0)
                     slice_end = time.perf_counter() + YIELD_AFTER_S
-            self._drained.set()
             now = time.monotonic()
             if self._closing and not queue:
                 break
@@ -395,8 +418,10 @@ class Recorder:
             if kind is _Kind.RAW:
                 if not self._sink.has_topic(topic):
                     self._add_topic(topic, RAW_FRAME_SCHEMA_NAME, RAW_FRAME_SCHEMA)
-                message = {"data": base64.b64encode(payload).decode("ascii"), "len": len(payload)}
-                self._write(topic, log_ns, message)
+                # what encode_json makes of {"data": base64, "len": n}, without its cost on
+                # every frame: base64's alphabet needs no JSON escaping
+                self._write_bytes(topic, log_ns, b'{"data":"' + base64.b64encode(payload)
+                                  + b'","len":' + str(len(payload)).encode() + b"}")
             elif kind is _Kind.EVENT:
                 level, text = payload
                 self._write_foxglove(topic, log_ns, foxglove_log(level, text, self.vehicle))
@@ -426,7 +451,9 @@ class Recorder:
         self._topic_schemas[topic] = (schema_name, schema)
 
     def _write(self, topic: str, log_ns: int, message: Mapping[str, Any]) -> None:
-        data = encode_json(message)
+        self._write_bytes(topic, log_ns, encode_json(message))
+
+    def _write_bytes(self, topic: str, log_ns: int, data: bytes) -> None:
         self._sink.write_bytes(topic, log_ns, data)
         if self._taps:
             name, schema = self._topic_schemas[topic]
