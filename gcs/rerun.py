@@ -33,7 +33,7 @@ from gcs.config import StationConfig, _build
 from gcs.errors import UsageError
 from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
 from gcs.position_controller import PositionController
-from gcs.station import StationSetup, TickInputs, average_imu
+from gcs.station import StationSetup, TickInputs
 from gcs.supervisor import Intent, Supervisor, SupervisorParams, TickIn, VehicleStatus
 from gcs.thrust_curve import ThrottleCurve
 from gcs.toml_file import read_toml
@@ -223,7 +223,7 @@ def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunO
         attitude = frame.attitudes[-1] if frame.attitudes else None
         sonars = frame.sonars
         baro = baro_altitude_m(frame.baros[-1].pressure_pa) if frame.baros else None
-        est = estimator.update_tick(average_imu(list(frame.imus)), sonars, attitude, t.t_s,
+        est = estimator.update_tick(list(frame.imus), sonars, attitude, t.t_s,
                                     at_rest=t.at_rest, baro_alt_m=baro)
         estimates[frame.log_ns] = est
         sup.step(TickIn(

@@ -49,7 +49,7 @@ from gcs.loop import FixedRateLoop
 from gcs.position_controller import PositionController
 from gcs.station_exit import emergency_land, let_go
 from gcs.station_intents import STICK_MAX_US, STICK_MIN_US, StationIntents
-from gcs.station_record import TickRecord, average_imu, record_tick
+from gcs.station_record import TickRecord, record_tick
 from gcs.station_types import (
     NEVER_S,
     ControlMode,
@@ -89,7 +89,6 @@ __all__ = [
     "StationSetup",
     "StationSnapshot",
     "TickInputs",
-    "average_imu",
     "control_mode",
 ]
 
@@ -337,7 +336,7 @@ class Station(StationIntents):
                 self._last_rx_s = max(self._last_rx_s, r.t_s)
         if self.mocap is not None:
             records = records + list(self.mocap.poll())
-        imu, sonars, attitude, baro = self._ingest(records)
+        imus, sonars, attitude, baro = self._ingest(records)
         hb = self._latest.get(Heartbeat)
         hb = hb if isinstance(hb, Heartbeat) else None
         status = VehicleStatus(
@@ -349,7 +348,7 @@ class Station(StationIntents):
         at_rest = (status.seen and not status.armed
                    and status.frame_age_s <= self.supervisor_params.lost_after_s)
         est = self.estimator.update_tick(
-            imu, sonars, attitude, t_s, at_rest=at_rest,
+            imus, sonars, attitude, t_s, at_rest=at_rest,
             baro_alt_m=None if baro is None else baro_altitude_m(baro.pressure_pa))
         self._estimate = est
         att = self._latest.get(Attitude)
@@ -406,7 +405,7 @@ class Station(StationIntents):
             self._event(t_s, EventLevel(int(note.level)), note.text)
 
     def _ingest(self, records: list[TelemetryRecord]) -> tuple[
-            Imu | None, list[Rangefinder], Attitude | None, Barometer | None]:
+            list[Imu], list[Rangefinder], Attitude | None, Barometer | None]:
         imus: list[Imu] = []
         sonars: list[Rangefinder] = []
         attitude: Attitude | None = None
@@ -442,7 +441,7 @@ class Station(StationIntents):
             elif isinstance(r, StatusText):
                 self._event(r.t_s, EventLevel.INFO if r.severity > 4 else EventLevel.WARNING,
                             f"vehicle: {r.text}")
-        return average_imu(imus), sonars, attitude, baro
+        return imus, sonars, attitude, baro
 
     def _record_tick(self, t_s: float, k: int, dt_s: float, est: AltEstimate,
                      records: list[TelemetryRecord], intents: list[Intent],

@@ -72,13 +72,3 @@ def record_tick(rec: Any, r: TickRecord) -> None:
             tick=last.k, period_ms=last.period_s * 1e3, jitter_ms=last.jitter_s * 1e3,
             lateness_ms=last.lateness_s * 1e3, compute_ms=last.compute_s * 1e3,
             overrun=last.overrun))
-
-
-def average_imu(imus: list[Imu]) -> Imu | None:
-    """One tick's IMU samples averaged: less vibration noise, same information (None if none)."""
-    if not imus:
-        return None
-    n = len(imus)
-    acc = tuple(sum(i.acc_b[a] for i in imus) / n for a in range(3))
-    last = imus[-1]
-    return Imu(last.t_s, last.sysid, acc, last.gyro_b, last.source, last.time_usec)

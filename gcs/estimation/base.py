@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from firmware_link.records import Attitude, Imu, Rangefinder
+from gcs.estimation.catch_up import CatchUp, TickInputs, average_imu
 from gcs.estimation.inputs import sonar_altitude_m, vertical_accel_up_mps2
 
 
@@ -163,6 +164,7 @@ class AltEstimator(ABC):
         self._initialised = False
         self._reject_run_start_s = 0.0
         self._reject_seen_s = -math.inf  # last rejected reading, or a repeat of it
+        self._catch_up = CatchUp()
 
     @abstractmethod
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
@@ -259,25 +261,48 @@ class AltEstimator(ABC):
 
     def update_tick(
         self,
-        imu: Imu | None,
+        imus: Sequence[Imu] | Imu | None,
         sonars: Sequence[Rangefinder],
         attitude: Attitude | None,
         t_s: float,
         at_rest: bool = False,
         baro_alt_m: float | None = None,
     ) -> AltEstimate:
-        """One control tick: `update` with the tick's first sonar reading, then each later one.
+        """One control tick with every sample it brought (see `catch_up` for late bursts)."""
+        samples = () if imus is None else (imus,) if isinstance(imus, Imu) else tuple(imus)
+        inputs = TickInputs(t_s, samples, tuple(sonars), attitude, at_rest, baro_alt_m)
+        est = self._catch_up.tick(self, inputs, self._run_tick)
+        assert isinstance(est, AltEstimate)
+        return est
+
+    @property
+    def burst_replays(self) -> int:
+        """Late bursts integrated at their samples' own times."""
+        return self._catch_up.replays
+
+    def snapshot(self) -> object:
+        """The filter's state, to be put back by `restore` (its containers copied)."""
+        return {k: _copied(v) for k, v in vars(self).items() if k != "_catch_up"}
+
+    def restore(self, state: object) -> None:
+        assert isinstance(state, dict)
+        vars(self).update({k: _copied(v) for k, v in state.items()})
+
+    def _run_tick(self, tick: TickInputs) -> AltEstimate:
+        """`update` with the tick's IMU samples averaged and its first sonar reading, then
+        each later reading.
 
         A tick can bring two readings (the sonar's rate beats against the loop's). When one of
         them re-based the estimate on another surface, the tick's estimate says so, whatever
         the later one did: the controller must move its setpoint by the jump, or it holds a
         table's height as an error and dives for the surface it just left.
         """
-        est = self.update(imu, sonars[0] if sonars else None, attitude, t_s, at_rest=at_rest,
-                          baro_alt_m=baro_alt_m)
+        sonars = tick.sonars
+        est = self.update(average_imu(tick.imus), sonars[0] if sonars else None, tick.attitude,
+                          tick.t_s, at_rest=tick.at_rest, baro_alt_m=tick.baro_alt_m)
         rebased = est.sonar_status is SonarStatus.REACQUIRED
         for extra in sonars[1:]:
-            est = self.update(None, extra, None, t_s)
+            est = self.update(None, extra, None, tick.t_s)
             rebased = rebased or est.sonar_status is SonarStatus.REACQUIRED
         if rebased and est.sonar_status is not SonarStatus.REACQUIRED:
             est = replace(est, sonar_status=SonarStatus.REACQUIRED, sonar_used=True)
@@ -451,3 +476,12 @@ class AltEstimator(ABC):
             self._last_sonar_t_s = t_s
             return SonarStatus.REACQUIRED, innovation
         return SonarStatus.REJECTED, innovation
+
+
+def _copied(v: object) -> object:
+    """A copy of a filter attribute that shares nothing mutable with it."""
+    if isinstance(v, deque):
+        return deque(v)
+    if isinstance(v, list):
+        return [_copied(x) for x in v]
+    return v

@@ -6,8 +6,10 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -73,6 +75,30 @@ class SitlProcess:
         except subprocess.TimeoutExpired:
             self.proc.kill()
             return self.proc.wait()
+
+
+@contextmanager
+def starved(proc: subprocess.Popen[str], stop_s: float, every_s: float) -> Iterator[None]:
+    """Take the CPU away from a process for `stop_s` of every `every_s` wall seconds
+    (SIGSTOP, SIGCONT), as a loaded machine does to a SITL. The stall's length is the fault
+    itself: these waits time it, they do not synchronise anything."""
+    done = threading.Event()
+
+    def stall() -> None:
+        while not done.wait(every_s - stop_s):
+            os.kill(proc.pid, signal.SIGSTOP)
+            time.sleep(stop_s)
+            os.kill(proc.pid, signal.SIGCONT)
+
+    worker = threading.Thread(target=stall, name="starve", daemon=True)
+    worker.start()
+    try:
+        yield
+    finally:
+        done.set()
+        worker.join()
+        if proc.poll() is None:
+            os.kill(proc.pid, signal.SIGCONT)
 
 
 class Station:

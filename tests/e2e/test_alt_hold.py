@@ -14,6 +14,7 @@ import pytest
 
 from gcs.cli import build_parser
 from gcs.commands.fly import fly
+from tests.e2e.sitl_proc import SitlProcess, starved
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = [pytest.mark.e2e, pytest.mark.timeout(240)]
@@ -28,10 +29,8 @@ def fly_json(*argv: str) -> dict[str, Any]:
 
 @pytest.mark.parametrize("profile", ["apm25", "copter4"])
 @pytest.mark.parametrize("transport", [
-    # Alone: a SITL starved of CPU falls behind and then sends 0.2 s of telemetry at once; the
-    # estimator takes one averaged IMU sample per tick and no acceleration once it is 60 ms
-    # old, so such bursts leave the estimate 0.3 m behind a 1 m step (overshoot 16-52 % with
-    # five flights at once beside three busy processes on two cores; 3-7 % with three). Open.
+    # Alone: a SITL starved of CPU falls behind and then sends its telemetry at once (see
+    # the starved-SITL test below for what the estimator does with such bursts)
     pytest.param("tcp", marks=pytest.mark.solo),
     pytest.param("serial", marks=pytest.mark.xfail(
         strict=False, reason="a 115200-baud line carries the telemetry at 16.7 Hz (3.2.1 "
@@ -52,6 +51,30 @@ def test_holds_1m_and_settles_a_1m_step(transport: str, profile: str) -> None:
     step = s["step"]
     assert step["overshoot_pct"] <= 15.0
     assert step["settle_time_s"] is not None and step["settle_time_s"] <= 4.0
+
+
+@pytest.mark.solo
+@pytest.mark.parametrize("profile", ["apm25", "copter4"])
+def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str) -> None:
+    """The SITL stopped for 0.15 s of every 0.3 s (0.3 s of simulated time at 2x) falls
+    behind, then sends what it missed at once. Taken as one averaged IMU sample per tick, the
+    bursts lost the climb's accelerations: apm25 overshot the 1 m step by 83 % and never
+    settled, copter4 held with 22 cm RMS (56 cm at worst). Each sample is now integrated at
+    its own time (gcs/estimation/catch_up.py): 10 % and 15 %, settled, 3-4 cm RMS."""
+    sitl = SitlProcess(["--tcp", "0", "--speedup", "2", "--seed", "3", "--profile", profile],
+                       ROOT)
+    try:
+        with starved(sitl.proc, 0.15, 0.3):
+            s = fly_json("--connect", "tcp:" + sitl.endpoint(1, "tcp"), "--alt", "1.0",
+                         "--hold", "10", "--step", "1.0", "--speedup", "2")
+    finally:
+        sitl.stop()
+    assert s["status"] == "ok", s["reason"]
+    assert s["error_source"] == "truth"
+    assert s["rms_error_m"] <= 0.06
+    step = s["step"]
+    assert step["overshoot_pct"] <= 25.0
+    assert step["settle_time_s"] is not None and step["settle_time_s"] <= 8.0
 
 
 def test_carpet_late_echoes_do_not_make_it_diverge() -> None:
