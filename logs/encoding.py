@@ -110,10 +110,14 @@ def _converter(cls: type) -> Callable[[Any], dict[str, Any]]:
     return conv
 
 
+# json.dumps with any option builds a new encoder per call; the writer encodes every message
+_COMPACT = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
+
+
 def encode_json(message: Mapping[str, Any]) -> bytes:
     """Compact UTF-8 JSON; a message that still holds a non-finite float has it nulled."""
     try:
-        return json.dumps(message, separators=(",", ":"), allow_nan=False).encode()
+        return _COMPACT(message).encode()
     except ValueError:
         return json.dumps(_null_non_finite(message), separators=(",", ":")).encode()
 

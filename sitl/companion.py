@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from sitl.link.codec import mavlink
+from sitl.link.codec import messages
 from sitl.link.view import VehicleView
 
 FACINGS: tuple[int, ...] = (0, 2, 4, 6, 24, 25)  # front, right, back, left, up, down
@@ -48,7 +48,7 @@ class Companion:
                 d = view.cache.proximity_m[i] if i < len(view.cache.proximity_m) else None
                 cm = c.ir_max_cm + 1 if d is None else round(d * 100.0)
                 out.append(
-                    mavlink.MAVLink_distance_sensor_message(
+                    messages.MAVLink_distance_sensor_message(
                         boot_ms,
                         c.ir_min_cm,
                         c.ir_max_cm,
@@ -67,5 +67,5 @@ class Companion:
             self._next_rad_s = max(self._next_rad_s + 1.0 / c.radiation_rate_hz, t_s)
             cps = view.cache.radiation_cps
             if cps is not None:
-                out.append(mavlink.MAVLink_named_value_float_message(boot_ms, b"RAD_CPS", cps))
+                out.append(messages.MAVLink_named_value_float_message(boot_ms, b"RAD_CPS", cps))
         return out

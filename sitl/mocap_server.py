@@ -11,7 +11,7 @@ in-memory lockstep endpoint (`sitl.lockstep`) sends exactly what the socket does
 from __future__ import annotations
 
 from sitl.link.broadcast import BroadcastServer
-from sitl.link.codec import MavCodec, mavlink
+from sitl.link.codec import MavCodec, messages
 from sitl.simulation import MocapFrame
 
 MOCAP_SYSID = 200
@@ -30,7 +30,7 @@ class MocapEncoder:
         for f in frames:
             s = f.sample
             self._codec.mav.srcComponent = f.sysid
-            msg = mavlink.MAVLink_att_pos_mocap_message(
+            msg = messages.MAVLink_att_pos_mocap_message(
                 int(s.t_s * 1e6), list(s.q_nb), *s.pos_n, [0.0] * 21
             )
             data += self._codec.encode(msg)

@@ -18,7 +18,7 @@ import math
 from collections.abc import Sequence
 
 from sitl.link.broadcast import BroadcastServer
-from sitl.link.codec import MavCodec, mavlink
+from sitl.link.codec import MavCodec, messages
 from sitl.simulation import VehicleRuntime
 
 TRUTH_SYSID = 201
@@ -54,7 +54,7 @@ class TruthEncoder:
         for rt in vehicles:
             tr = rt.vehicle.truth
             self._codec.mav.srcComponent = rt.sysid
-            msg = mavlink.MAVLink_local_position_ned_message(
+            msg = messages.MAVLink_local_position_ned_message(
                 round(t_s * 1e3) & 0xFFFFFFFF, *tr.pos_n, *tr.vel_n
             )
             data += self._codec.encode(msg)

@@ -24,7 +24,7 @@ from sitl.companion import Companion
 from sitl.link import telemetry as tm
 from sitl.link import telemetry_full
 from sitl.link.channel import Channel
-from sitl.link.codec import mavlink
+from sitl.link.codec import mavlink, messages
 from sitl.link.view import VehicleView
 
 MAV_CMD_DO_SET_MODE = 176
@@ -170,7 +170,7 @@ class VehicleLink:
             else (MAV_RESULT_ACCEPTED if accepted else MAV_RESULT_FAILED)
         )
         ch.send_reply(
-            mavlink.MAVLink_command_ack_message(
+            messages.MAVLink_command_ack_message(
                 command, code, 0, 0, msg.get_srcSystem(), msg.get_srcComponent()
             )
         )
@@ -212,7 +212,7 @@ class VehicleLink:
     def _param_value(self, idx: int) -> Any:
         p = self.view.params
         spec = p.spec(idx)
-        return mavlink.MAVLink_param_value_message(
+        return messages.MAVLink_param_value_message(
             spec.name.encode("ascii"), p.value_at(idx), int(spec.ptype), len(p), idx
         )
 
@@ -232,7 +232,7 @@ class VehicleLink:
         if ap.arm_completed is not None:
             for ch, sysid, compid in self._pending_arm:
                 ch.send_reply(
-                    mavlink.MAVLink_command_ack_message(
+                    messages.MAVLink_command_ack_message(
                         MAV_CMD_COMPONENT_ARM_DISARM, MAV_RESULT_ACCEPTED, 0, 0, sysid, compid
                     )
                 )

@@ -17,7 +17,7 @@ import math
 from typing import Any
 
 from sitl.autopilot import FlightMode, Key, Profile
-from sitl.link.codec import mavlink
+from sitl.link.codec import messages
 from sitl.link.view import VehicleView
 
 GRAVITY_MSS = 9.80665
@@ -52,7 +52,7 @@ def heartbeat(v: VehicleView) -> Any:
         base_mode = BASE_MODE_BOOT
     else:
         base_mode = BASE_MODE_DISARMED
-    return mavlink.MAVLink_heartbeat_message(
+    return messages.MAVLink_heartbeat_message(
         MAV_TYPE_QUADROTOR,
         MAV_AUTOPILOT_ARDUPILOTMEGA,
         base_mode,
@@ -64,14 +64,14 @@ def heartbeat(v: VehicleView) -> Any:
 
 def statustext(severity: int, text: str) -> Any:
     """STATUSTEXT (50 characters at most)."""
-    return mavlink.MAVLink_statustext_message(severity, text.encode("ascii", "replace")[:50])
+    return messages.MAVLink_statustext_message(severity, text.encode("ascii", "replace")[:50])
 
 
 def attitude(v: VehicleView) -> Any:
     """ATTITUDE: the autopilot's estimate."""
     st = v.autopilot.state
     p, q, r = st.gyro_rads
-    return mavlink.MAVLink_attitude_message(
+    return messages.MAVLink_attitude_message(
         _boot_ms(v), st.roll_rad, st.pitch_rad, st.yaw_rad, p, q, r
     )
 
@@ -80,7 +80,7 @@ def raw_imu(v: VehicleView) -> Any:
     """RAW_IMU in mg and mrad/s (see module docstring)."""
     c = v.cache
     k = 1000.0 / GRAVITY_MSS
-    return mavlink.MAVLink_raw_imu_message(
+    return messages.MAVLink_raw_imu_message(
         int(v.t_s * 1e6),
         _clamp16(c.acc_b[0] * k),
         _clamp16(c.acc_b[1] * k),
@@ -100,7 +100,7 @@ def scaled_imu(v: VehicleView) -> Any:
     """SCALED_IMU (Copter 4.x), same units as RAW_IMU."""
     c = v.cache
     k = 1000.0 / GRAVITY_MSS
-    return mavlink.MAVLink_scaled_imu_message(
+    return messages.MAVLink_scaled_imu_message(
         _boot_ms(v),
         _clamp16(c.acc_b[0] * k),
         _clamp16(c.acc_b[1] * k),
@@ -118,7 +118,7 @@ def scaled_imu(v: VehicleView) -> Any:
 def scaled_pressure(v: VehicleView) -> Any:
     """SCALED_PRESSURE: hPa and centidegrees."""
     c = v.cache
-    return mavlink.MAVLink_scaled_pressure_message(
+    return messages.MAVLink_scaled_pressure_message(
         _boot_ms(v), c.pressure_pa / 100.0, 0.0, _clamp16(c.temperature_c * 100.0), 0
     )
 
@@ -127,7 +127,7 @@ def sys_status(v: VehicleView, drop_rate_comm: int, errors_comm: int) -> Any:
     """SYS_STATUS with the battery and the link's error counters."""
     c = v.cache
     load = 350  # the APM 2.5's main loop is busy; 35 % is a typical report
-    return mavlink.MAVLink_sys_status_message(
+    return messages.MAVLink_sys_status_message(
         _SENSORS,
         _SENSORS,
         _SENSORS,
@@ -152,7 +152,7 @@ def vfr_hud(v: VehicleView) -> Any:
     st = v.autopilot.state
     heading = int(math.degrees(st.yaw_rad)) % 360
     vn, ve, _ = v.cache.truth_vel_n
-    return mavlink.MAVLink_vfr_hud_message(
+    return messages.MAVLink_vfr_hud_message(
         0.0, math.hypot(vn, ve), heading, round(st.throttle * 100.0), st.alt_m, st.climb_ms
     )
 
@@ -161,15 +161,15 @@ def rc_channels(v: VehicleView) -> Any:
     """RC_CHANNELS_RAW (3.2.1) or RC_CHANNELS (4.x): what the autopilot sees."""
     ch = v.autopilot.radio.channels()
     if v.profile is Profile.APM25:
-        return mavlink.MAVLink_rc_channels_raw_message(_boot_ms(v), 0, *ch, 255)
-    return mavlink.MAVLink_rc_channels_message(_boot_ms(v), 8, *ch, *([0] * 10), 255)
+        return messages.MAVLink_rc_channels_raw_message(_boot_ms(v), 0, *ch, 255)
+    return messages.MAVLink_rc_channels_message(_boot_ms(v), 8, *ch, *([0] * 10), 255)
 
 
 def servo_output_raw(v: VehicleView) -> Any:
     """SERVO_OUTPUT_RAW: motors 1..4 in ArduCopter order (right, left, front, back)."""
     st = v.autopilot.state
     pwm = st.motors.pwm_us() if st.armed else (1000, 1000, 1000, 1000)
-    return mavlink.MAVLink_servo_output_raw_message(
+    return messages.MAVLink_servo_output_raw_message(
         int(v.t_s * 1e6) & 0xFFFFFFFF, 0, *pwm, 0, 0, 0, 0, *([0] * 8)
     )
 
@@ -189,13 +189,13 @@ def rangefinder_cm(v: VehicleView) -> int:
 
 def rangefinder(v: VehicleView) -> Any:
     """RANGEFINDER: metres as a float32 of whole centimetres / 100 (3.2.1's distance_cm * 0.01)."""
-    return mavlink.MAVLink_rangefinder_message(rangefinder_cm(v) * 0.01, 0.0)
+    return messages.MAVLink_rangefinder_message(rangefinder_cm(v) * 0.01, 0.0)
 
 
 def distance_sensor_down(v: VehicleView) -> Any:
     """DISTANCE_SENSOR for the down sonar (4.x): uint16 centimetres."""
     p = v.params
-    return mavlink.MAVLink_distance_sensor_message(
+    return messages.MAVLink_distance_sensor_message(
         _boot_ms(v),
         round(p.k(Key.RNG_MIN_M) * 100.0),
         round(p.k(Key.RNG_MAX_M) * 100.0),
@@ -225,7 +225,7 @@ def sim_state(v: VehicleView) -> Any:
     lat, lon, alt = _latlon(v)
     r, p, y = c.truth_euler
     vn, ve, vd = c.truth_vel_n
-    return mavlink.MAVLink_sim_state_message(
+    return messages.MAVLink_sim_state_message(
         *c.truth_q_nb,
         r,
         p,

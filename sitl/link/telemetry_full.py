@@ -15,7 +15,7 @@ import math
 from typing import Any
 
 from sitl.autopilot import FlightMode
-from sitl.link.codec import mavlink
+from sitl.link.codec import messages
 from sitl.link.view import VehicleView
 
 GRAVITY_MSS = 9.80665
@@ -34,21 +34,21 @@ def _clamp16(x: float) -> int:
 
 def ahrs(v: VehicleView) -> Any:
     """AHRS: DCM's state (no drift estimate modelled, full accelerometer weight)."""
-    return mavlink.MAVLink_ahrs_message(0.0, 0.0, 0.0, 1.0, 0.0, 0.002, 0.0)
+    return messages.MAVLink_ahrs_message(0.0, 0.0, 0.0, 1.0, 0.0, 0.002, 0.0)
 
 
 def ahrs2(v: VehicleView) -> Any:
     """AHRS2: the secondary estimate (here the same attitude and height)."""
     st = v.autopilot.state
     alt = v.origin.alt_amsl_m + st.alt_m
-    return mavlink.MAVLink_ahrs2_message(st.roll_rad, st.pitch_rad, st.yaw_rad, alt, 0, 0)
+    return messages.MAVLink_ahrs2_message(st.roll_rad, st.pitch_rad, st.yaw_rad, alt, 0, 0)
 
 
 def global_position_int(v: VehicleView) -> Any:
     """GLOBAL_POSITION_INT: no horizontal fix; alt above sea level, relative_alt above home."""
     st = v.autopilot.state
     hdg = round(math.degrees(st.yaw_rad) % 360.0 * 100.0) % 36000
-    return mavlink.MAVLink_global_position_int_message(
+    return messages.MAVLink_global_position_int_message(
         _boot_ms(v),
         0,
         0,
@@ -63,24 +63,24 @@ def global_position_int(v: VehicleView) -> Any:
 
 def gps_raw_int(v: VehicleView) -> Any:
     """GPS_RAW_INT of an APM without a GPS lock."""
-    return mavlink.MAVLink_gps_raw_int_message(
+    return messages.MAVLink_gps_raw_int_message(
         int(v.t_s * 1e6), GPS_NO_FIX, 0, 0, 0, 65535, 65535, 0, 65535, 0
     )
 
 
 def hwstatus(v: VehicleView) -> Any:
     """HWSTATUS (3.2.1): board voltage in mV."""
-    return mavlink.MAVLink_hwstatus_message(5000, 0)
+    return messages.MAVLink_hwstatus_message(5000, 0)
 
 
 def meminfo(v: VehicleView) -> Any:
     """MEMINFO: what the APM 2.5 reports free (bytes)."""
-    return mavlink.MAVLink_meminfo_message(0, 1800, 0)
+    return messages.MAVLink_meminfo_message(0, 1800, 0)
 
 
 def mission_current(v: VehicleView) -> Any:
     """MISSION_CURRENT: no mission."""
-    return mavlink.MAVLink_mission_current_message(0)
+    return messages.MAVLink_mission_current_message(0)
 
 
 def nav_controller_output(v: VehicleView) -> Any:
@@ -88,30 +88,30 @@ def nav_controller_output(v: VehicleView) -> Any:
     st = v.autopilot.state
     alt_error = st.target_alt_m - st.alt_m if st.mode is not FlightMode.STABILIZE else 0.0
     hdg = round(math.degrees(st.yaw_rad)) % 360
-    return mavlink.MAVLink_nav_controller_output_message(
+    return messages.MAVLink_nav_controller_output_message(
         math.degrees(st.roll_rad), math.degrees(st.pitch_rad), hdg, hdg, 0, alt_error, 0.0, 0.0
     )
 
 
 def system_time(v: VehicleView) -> Any:
     """SYSTEM_TIME: no GPS, so no UNIX time."""
-    return mavlink.MAVLink_system_time_message(0, _boot_ms(v))
+    return messages.MAVLink_system_time_message(0, _boot_ms(v))
 
 
 def terrain_report(v: VehicleView) -> Any:
     """TERRAIN_REPORT: no terrain data loaded."""
-    return mavlink.MAVLink_terrain_report_message(0, 0, 0, 0.0, v.autopilot.state.alt_m, 0, 0)
+    return messages.MAVLink_terrain_report_message(0, 0, 0, 0.0, v.autopilot.state.alt_m, 0, 0)
 
 
 def terrain_request(v: VehicleView) -> Any:
     """TERRAIN_REQUEST: the firmware asks the GCS for terrain it will not get."""
-    return mavlink.MAVLink_terrain_request_message(0, 0, 100, 0xFFFFFFFFFFFFFFFF)
+    return messages.MAVLink_terrain_request_message(0, 0, 100, 0xFFFFFFFFFFFFFFFF)
 
 
 def sensor_offsets(v: VehicleView) -> Any:
     """SENSOR_OFFSETS (3.2.1): raw pressure and temperature, no compass."""
     c = v.cache
-    return mavlink.MAVLink_sensor_offsets_message(
+    return messages.MAVLink_sensor_offsets_message(
         0, 0, 0, 0.0, int(c.pressure_pa), int(c.temperature_c * 100.0), 0.0, 0.0, 0.0,
         0.0, 0.0, 0.0,
     )
@@ -121,7 +121,7 @@ def scaled_imu2(v: VehicleView) -> Any:
     """SCALED_IMU2: the airframe has one IMU; the second instance reports the same sensor."""
     c = v.cache
     k = 1000.0 / GRAVITY_MSS
-    return mavlink.MAVLink_scaled_imu2_message(
+    return messages.MAVLink_scaled_imu2_message(
         _boot_ms(v),
         _clamp16(c.acc_b[0] * k),
         _clamp16(c.acc_b[1] * k),
@@ -138,27 +138,27 @@ def scaled_imu2(v: VehicleView) -> Any:
 
 def scaled_imu3(v: VehicleView) -> Any:
     """SCALED_IMU3: no third IMU (the 4.7 SITL's INS_ACC3_ID is 0): zeros."""
-    return mavlink.MAVLink_scaled_imu3_message(_boot_ms(v), 0, 0, 0, 0, 0, 0, 0, 0, 0, 0)
+    return messages.MAVLink_scaled_imu3_message(_boot_ms(v), 0, 0, 0, 0, 0, 0, 0, 0, 0, 0)
 
 
 def scaled_pressure2(v: VehicleView) -> Any:
     """SCALED_PRESSURE2: the second barometer instance reports the same sensor."""
     c = v.cache
-    return mavlink.MAVLink_scaled_pressure2_message(
+    return messages.MAVLink_scaled_pressure2_message(
         _boot_ms(v), c.pressure_pa / 100.0, 0.0, _clamp16(c.temperature_c * 100.0), 0
     )
 
 
 def power_status(v: VehicleView) -> Any:
     """POWER_STATUS: board and servo rail in mV."""
-    return mavlink.MAVLink_power_status_message(5000, 0, 0)
+    return messages.MAVLink_power_status_message(5000, 0, 0)
 
 
 def battery_status(v: VehicleView) -> Any:
     """BATTERY_STATUS: one pack, total voltage in the first cell, the rest unknown."""
     c = v.cache
     cells = [min(65534, int(c.battery_v * 1000.0))] + [65535] * 9
-    return mavlink.MAVLink_battery_status_message(
+    return messages.MAVLink_battery_status_message(
         0,
         0,
         0,
@@ -173,7 +173,7 @@ def battery_status(v: VehicleView) -> Any:
 
 def ekf_status_report(v: VehicleView) -> Any:
     """EKF_STATUS_REPORT: attitude and vertical solution good, no horizontal position."""
-    return mavlink.MAVLink_ekf_status_report_message(
+    return messages.MAVLink_ekf_status_report_message(
         EKF_FLAGS_ATTITUDE_VERT, 0.05, 0.0, 0.05, 0.0, 0.0
     )
 
@@ -183,7 +183,7 @@ def vibration(v: VehicleView) -> Any:
     c = v.cache
     st = v.autopilot.state
     g_z = GRAVITY_MSS * math.cos(st.roll_rad) * math.cos(st.pitch_rad)
-    return mavlink.MAVLink_vibration_message(
+    return messages.MAVLink_vibration_message(
         int(v.t_s * 1e6), abs(c.acc_b[0]), abs(c.acc_b[1]), abs(c.acc_b[2] + g_z), 0, 0, 0
     )
 
@@ -196,14 +196,14 @@ def esc_telemetry_1_to_4(v: VehicleView) -> Any:
     rpm = [int(m * ESC_RPM_AT_FULL) for m in motors]
     volts = [int(c.battery_v * 100.0)] * 4
     amps = [int(c.current_a * 25.0)] * 4
-    return mavlink.MAVLink_esc_telemetry_1_to_4_message(
+    return messages.MAVLink_esc_telemetry_1_to_4_message(
         [35] * 4, volts, amps, [0] * 4, rpm, [0] * 4
     )
 
 
 def timesync(v: VehicleView) -> Any:
     """TIMESYNC request (tc1 0) with the vehicle's clock in ns."""
-    return mavlink.MAVLink_timesync_message(0, int(v.t_s * 1e9))
+    return messages.MAVLink_timesync_message(0, int(v.t_s * 1e9))
 
 
 BUILDERS = {
