@@ -48,11 +48,12 @@ def synthetic(seeds: int) -> None:
 
 def starved_flight(profile: str, seed: int, stop_s: float, every_s: float) -> dict:
     sitl = SitlProcess(["--tcp", "0", "--speedup", "2", "--seed", str(seed),
-                        "--profile", profile], ROOT)
+                        "--profile", profile, "--mocap-port", "0"], ROOT)
     try:
         args = build_parser().parse_args([
             "fly", "--no-record", "--fix-failsafe", "--connect", "tcp:" + sitl.endpoint(1, "tcp"),
-            "--alt", "1.0", "--hold", "10", "--step", "1.0", "--speedup", "2"])
+            "--mocap", sitl.mocap_url(), "--alt", "1.0", "--hold", "10", "--step", "1.0",
+            "--speedup", "2"])
         with starved(sitl.proc, stop_s, every_s), contextlib.redirect_stdout(io.StringIO()):
             return fly(args)
     finally:

@@ -60,6 +60,13 @@ class SitlProcess:
                 return line[len(prefix) :]
         raise AssertionError(f"no {kind} endpoint for vehicle {sysid} in {self.lines}")
 
+    def mocap_url(self) -> str:
+        """The `mocap tcp:...` line's URL (the SITL started with `--mocap-port`)."""
+        for line in self.lines:
+            if line.startswith("mocap "):
+                return line.split()[1]
+        raise AssertionError(f"no mocap endpoint in {self.lines}")
+
     def stderr(self) -> str:
         """What the process wrote to stderr (after it ended)."""
         if self.proc.poll() is None or self.proc.stderr is None:
