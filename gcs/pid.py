@@ -69,6 +69,11 @@ class PidTerms:
     saturated: bool
 
 
+def _same(a: float, b: float) -> bool:
+    """The same float, sign of zero included."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
+
+
 class Pid:
     """Discrete PID with derivative on measurement, anti-wind-up, saturation, bumpless engage."""
 
@@ -160,8 +165,14 @@ class Pid:
         saved = self._shaped, self._shaped_rate
         prev = self._shaped_rate
         for _ in range(max(1, round(self.gains.lead_s / dt_s))):
+            before = self._shaped
             prev = self._shaped_rate
             self._shape(target, dt_s, slew_per_s)
+            if _same(before, self._shaped) and _same(prev, self._shaped_rate):
+                # a step that changed nothing changes nothing after it either (the step is a
+                # function of that state alone): a settled profile needs no more steps
+                prev = self._shaped_rate
+                break
         ahead = self._shaped, self._shaped_rate, prev
         self._shaped, self._shaped_rate = saved
         return ahead  # type: ignore[return-value]

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
+from operator import attrgetter
 from typing import Any
 
 try:
@@ -46,6 +47,11 @@ def _payload_fn(cls: type) -> Payload | None:
         else:
             getters.append((name, n))
     pack = unpacker.pack
+    if all(n == 0 for _, n in getters):  # one value per field: fetched in C, in one call
+        get = attrgetter(*(a for a, _ in getters))
+        if len(getters) == 1:
+            return lambda msg: pack(get(msg))
+        return lambda msg: pack(*get(msg))
 
     def payload(msg: Any) -> bytes:
         values: list[Any] = []

@@ -165,3 +165,35 @@ def test_lead_acts_on_the_profile_ahead_without_changing_the_profile() -> None:
     assert a.error == pytest.approx(1.0) and b.error == pytest.approx(1.0)  # both arrived
     with pytest.raises(ValueError):
         dataclasses.replace(base, lead_s=-0.1)
+
+
+class _EveryStepAhead(Pid):
+    """The profile ahead stepped all `lead_s / dt` times, settled or not (the reference)."""
+
+    def _ahead(self, target: float, dt_s: float,
+               slew_per_s: float | None) -> tuple[float, float, float]:
+        saved = self._shaped, self._shaped_rate
+        prev = self._shaped_rate
+        for _ in range(max(1, round(self.gains.lead_s / dt_s))):
+            prev = self._shaped_rate
+            self._shape(target, dt_s, slew_per_s)
+        ahead = self._shaped, self._shaped_rate, prev
+        self._shaped, self._shaped_rate = saved
+        return ahead  # type: ignore[return-value]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_settled_profile_ahead_is_not_stepped_further_and_nothing_changes(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    gains = dataclasses.replace(GAINS, setpoint_slew_per_s=0.5, setpoint_accel_per_s2=2.0,
+                                ff_accel=0.1, lead_s=0.45)
+    fast, ref = Pid(gains), _EveryStepAhead(gains)
+    target, measurement = 0.0, 0.0
+    for k in range(2000):
+        if rng.random() < 0.01:  # steps, long holds, and now and then a slower move
+            target = float(rng.choice([0.0, 1.0, -0.5, 1.0 + 1e-9, -0.0]))
+        measurement += 0.05 * (target - measurement) + float(rng.normal(0.0, 1e-3))
+        slew = 0.2 if k % 500 < 100 else None
+        a = fast.update(target, measurement, 0.025, slew_per_s=slew)
+        b = ref.update(target, measurement, 0.025, slew_per_s=slew)
+        assert repr(a) == repr(b)
