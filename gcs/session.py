@@ -28,7 +28,7 @@ from firmware_link import (
 from firmware_link.records import Battery, Dialect, MocapPose
 from firmware_link.truth_link import TruthLink, TruthRecorder
 from gcs.clock import Clock, MonotonicClock, ScaledClock
-from gcs.config import load_config
+from gcs.config import StationConfig, load_config
 from gcs.errors import UsageError
 from gcs.foxglove_feed import DEFAULT_WORLD, FoxgloveFeed, open_live, world_boxes
 from gcs.parallel_open import open_in_parallel
@@ -124,9 +124,11 @@ class StationSession:
     # a recorder that cannot keep up makes the station wait (simulated time) instead of dropping
     recording_blocks = False
 
-    def __init__(self, options: SessionOptions) -> None:
+    def __init__(self, options: SessionOptions, *, config: StationConfig | None = None) -> None:
+        """`config`: the stations' configuration (None: `options.config`'s file, or defaults)."""
         options.validate()
         self.options = options
+        self.station_config = config
         self.clock: Clock = (
             MonotonicClock(options.spin_s) if options.speedup == 1.0
             else ScaledClock(options.speedup, options.spin_s)
@@ -193,7 +195,7 @@ class StationSession:
     def _open(self) -> None:
         o = self.options
         key = self._key()
-        config = load_config(o.config)
+        config = self.station_config if self.station_config is not None else load_config(o.config)
         urls: dict[int, str] = {}
         mocap_url = o.mocap
         if o.connect is None:

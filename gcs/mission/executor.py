@@ -74,9 +74,10 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
     if options.lockstep:
         from gcs.lockstep_session import LockstepSession
 
-        session = lockstep = LockstepSession(session_options, faults=options.link_faults)
+        session = lockstep = LockstepSession(session_options, config=spec.station,
+                                             faults=options.link_faults)
     else:
-        session = StationSession(session_options)
+        session = StationSession(session_options, config=spec.station)
     with session:
         clock = lockstep.team_clock() if lockstep is not None else None
         crafts: dict[int, Craft] = {}

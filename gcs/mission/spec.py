@@ -18,6 +18,8 @@ y east and altitude positive up (metres); they are turned into local NED here, o
                   their field names, plus max_steps, seed, noise_sigma_m, max_samples,
                   floor_margin_m (see gcs.mission.planner_params)
     [goal]        position = [x, y, alt], individual = [[x, y, alt], ...], tolerance_m
+    [station]     the vehicles' station configuration over its defaults, as a station TOML
+                  (`fly --config`) writes it, e.g. [station.position.gains_xy]
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from gcs.config import StationConfig, config_from_table
 from gcs.errors import UsageError
 
 Vec3 = tuple[float, float, float]
@@ -71,6 +74,7 @@ class MissionSpec:
     position_tolerance_m: float = 0.08  # a set position is reached within this (mocap, 3-D)
     settle_s: float = 0.4  # ... for this long (station clock)
     step_timeout_s: float = 8.0  # a set position not reached by then counts as reached anyway
+    station: StationConfig | None = None  # None: the station's defaults (or `--config`'s)
 
     @property
     def goal_n(self) -> Vec3 | None:
@@ -198,6 +202,12 @@ def load_mission(path: str | Path) -> MissionSpec:
 
     goals_n, tolerance_m = _goals(r, data, planner)
 
+    station: StationConfig | None = None
+    if "station" in data:
+        if not isinstance(data["station"], dict):
+            raise r.fail("station", "expected a table of station settings")
+        station = config_from_table(data["station"], f"{path}: station.")
+
     return MissionSpec(
         path=path,
         name=name,
@@ -216,6 +226,7 @@ def load_mission(path: str | Path) -> MissionSpec:
         position_tolerance_m=position_tolerance_m,
         settle_s=settle_s,
         step_timeout_s=step_timeout_s,
+        station=station,
     )
 
 

@@ -8,6 +8,7 @@ import pytest
 
 from gcs.errors import UsageError
 from gcs.mission.spec import PlannerKind, load_mission
+from gcs.position_controller import PositionControllerParams
 
 GOOD = """\
 name = "table"
@@ -70,3 +71,13 @@ def test_duplicate_sysid(tmp_path: Path) -> None:
     text = GOOD + "\n[[vehicles]]\nsysid = 2\n\n[[vehicles]]\nsysid = 2\n"
     with pytest.raises(UsageError, match=r"vehicles\[1\].sysid: system id 2 used twice"):
         load_mission(write(tmp_path, text))
+
+
+def test_a_station_table_sets_the_stations_config_over_its_defaults(tmp_path: Path) -> None:
+    assert load_mission(write(tmp_path, GOOD)).station is None
+    text = GOOD + "\n[station.position.gains_xy]\nsetpoint_slew_per_s = 1.0\n"
+    gains = load_mission(write(tmp_path, text)).station.position.gains_xy  # type: ignore[union-attr]
+    assert gains.setpoint_slew_per_s == 1.0
+    assert gains.kp == PositionControllerParams().gains_xy.kp  # the rest as the station's own
+    with pytest.raises(UsageError, match=r"m\.toml: station\.position\.gains_xy\.slew: unknown"):
+        load_mission(write(tmp_path, GOOD + "\n[station.position.gains_xy]\nslew = 1.0\n"))
