@@ -12,6 +12,7 @@ from __future__ import annotations
 import enum
 import math
 import threading
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -29,6 +30,8 @@ ALT_RESEND_M = 0.01  # re-aim the altitude hold when the setpoint moved this muc
 OFFSET_JUMP_M = 0.1  # estimate-minus-mocap change between looks that is a surface change
 ALT_RATE_MPS = 0.4  # altitude set positions move at this rate (a jump upsets the estimator)
 POLL_S = 0.1
+# poses kept for `mocap_since`: 10 s at the 100 Hz of motion capture, more than any count
+MOCAP_TRAIL = 1000
 
 
 class CraftPhase(enum.Enum):
@@ -56,6 +59,8 @@ class _Books:
     truth: list[TruthSample] = field(default_factory=list)
     mocap_at_truth: list[tuple[Vec3, Vec3]] = field(default_factory=list)  # (mocap, truth)
     last_mocap: Vec3 | None = None
+    mocap_trail: deque[tuple[float, Vec3]] = field(
+        default_factory=lambda: deque(maxlen=MOCAP_TRAIL))  # (station time, position)
 
 
 def yaw_of(q_nb: tuple[float, float, float, float]) -> float:
@@ -94,6 +99,7 @@ class Craft:
                 b.radiation.append(r)
             elif isinstance(r, MocapPose):
                 b.last_mocap = r.pos_n
+                b.mocap_trail.append((r.t_s, r.pos_n))
             elif (isinstance(r, SimTruth) and self.keeps_truth
                   and all(math.isfinite(c) for c in r.pos_n)):
                 b.truth.append(TruthSample(r.t_s, r.pos_n, self.phase))
@@ -133,6 +139,12 @@ class Craft:
         """Radiation readings stamped at or after `t_s`."""
         with self._lock:
             return [r for r in self._b.radiation if r.t_s >= t_s]
+
+    def mocap_since(self, t_s: float) -> list[tuple[float, Vec3]]:
+        """Motion-capture poses (station time, NED position) received at or after `t_s`, every
+        one, not the snapshot's newest: what a count is attributed to (the last 10 s)."""
+        with self._lock:
+            return [(t, q) for t, q in self._b.mocap_trail if t >= t_s]
 
     def truth(self) -> list[TruthSample]:
         """The ground-truth track so far."""

@@ -107,7 +107,7 @@ def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
 @pytest.mark.timeout(300)
 def test_without_the_truth_the_sitl_flight_maps_unscored_and_its_map_scores_afterwards(
         tmp_path: Path) -> None:
-    # the whole mapping flight (about 520 s of flight) in lockstep, the SITL's own bytes on
+    # the whole mapping flight (about 250 s of flight) in lockstep, the SITL's own bytes on
     # simulated time: the SITL simulates the sources, the station and the mapper never hear
     # where they are. (Sped up over TCP at 4x the telemetry came in bursts; at 2x the flight
     # took five minutes of the suite.)
