@@ -16,6 +16,7 @@ import math
 import types
 import typing
 from collections.abc import Callable, Mapping
+from operator import attrgetter, itemgetter
 from typing import Any
 
 VEC3_KEYS = ("x", "y", "z")
@@ -95,16 +96,35 @@ def _field_converter(hint: Any) -> Callable[[Any], Any]:
 
 
 def _converter(cls: type) -> Callable[[Any], dict[str, Any]]:
-    """A dataclass → dict converter built once per class (the writer thread's hot path)."""
+    """A dataclass → dict converter built once per class (the writer thread's hot path).
+
+    The fields are fetched in one call and checked for plain values in one pass; only the 3-
+    and 4-float tuples, and a value that is not plain, go through a converter of their own."""
     conv = _CONVERTERS.get(cls)
     if conv is None:
         hints = _hints(cls)
-        fields = tuple(
-            (f.name, _field_converter(hints.get(f.name))) for f in dataclasses.fields(cls)
-        )
+        names = tuple(f.name for f in dataclasses.fields(cls))
+        fields = tuple((k, name, hints.get(name), _field_converter(hints.get(name)))
+                       for k, name in enumerate(names))
+        special = tuple((k, name, c) for k, name, hint, c in fields
+                        if _fixed_float_tuple_len(hint))
+        plain = tuple((k, name, hint) for k, name, hint, _ in fields
+                      if not _fixed_float_tuple_len(hint))
+        get = (attrgetter(*names) if len(names) > 1
+               else lambda o: tuple(getattr(o, name) for name in names))
+        plain_get = (itemgetter(*(k for k, _, _ in plain)) if len(plain) > 1
+                     else (lambda v: tuple(v[k] for k, _, _ in plain)))
 
         def conv(obj: Any) -> dict[str, Any]:
-            return {name: c(getattr(obj, name)) for name, c in fields}
+            values = get(obj)
+            out = dict(zip(names, values, strict=True))
+            for k, name, c in special:
+                out[name] = c(values[k])
+            if not _PLAIN_TYPES.issuperset(map(type, plain_get(values))):
+                for k, name, hint in plain:
+                    if type(values[k]) not in _PLAIN_TYPES:
+                        out[name] = to_jsonable(values[k], hint)
+            return out
 
         _CONVERTERS[cls] = conv
     return conv

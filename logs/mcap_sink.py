@@ -29,6 +29,18 @@ CHUNK_SIZE_BYTES = 512 * 1024
 # a Message record's head: opcode 0x05, record length, channel, sequence, log and publish times
 _MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 _MESSAGE_HEAD_FIELDS = 22
+_INDEX_HEAD = struct.Struct("<BQHI")  # opcode 0x07, record length, channel, records' bytes
+
+
+class _PackedIndex(MessageIndex):
+    """A chunk's message index for one channel, written as the library writes it, in one
+    piece instead of two calls per message."""
+
+    def write(self, stream: Any) -> None:
+        n = len(self.records)
+        stream.write(_INDEX_HEAD.pack(7, 6 + 16 * n, self.channel_id, 16 * n))
+        if n:
+            stream.write(struct.pack(f"<{2 * n}Q", *(v for r in self.records for v in r)))
 
 
 class LeanWriter(Writer):
@@ -71,7 +83,7 @@ class LeanWriter(Writer):
             cb.message_end_time = log_time
         index = cb.message_indices.get(channel_id)
         if index is None:
-            index = cb.message_indices[channel_id] = MessageIndex(channel_id=channel_id,
+            index = cb.message_indices[channel_id] = _PackedIndex(channel_id=channel_id,
                                                                    records=[])
         records = cb.record_writer
         index.records.append((log_time, records.count))
@@ -79,7 +91,8 @@ class LeanWriter(Writer):
         records.write(_MESSAGE_HEAD.pack(5, _MESSAGE_HEAD_FIELDS + len(data), channel_id,
                                          sequence, log_time, publish_time))
         records.write(data)
-        self._finalize()
+        if records.count > self._chunk_size:
+            self._finalize()
 
 
 def schema_name_for_topic(topic: str) -> str:
