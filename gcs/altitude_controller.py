@@ -110,7 +110,8 @@ class AltitudeController:
         a0 = 0.0
         if throttle_us is not None:
             a0 = self.accel_for_throttle(throttle_us, roll_rad, pitch_rad)
-        self.pid.engage(estimate.alt_m, estimate.alt_m, a0)
+        alt = _flown_alt(estimate)
+        self.pid.engage(alt, alt, a0)
         self._clamped = 0
 
     def surface_changed(self, jump_m: float) -> None:
@@ -134,11 +135,12 @@ class AltitudeController:
         and the integrator must not wind up against it. `rate_mps`: the setpoint profile's speed
         for this move (None: the controller's own)."""
         p = self.params
-        error = setpoint_m - estimate.alt_m
+        alt = _flown_alt(estimate)
+        error = setpoint_m - alt
         integrate = not (on_floor or (self._clamped > 0 and error > 0.0)
                          or (self._clamped < 0 and error < 0.0))
-        terms: PidTerms = self.pid.update(setpoint_m, estimate.alt_m, dt_s,
-                                          measurement_rate=estimate.vel_mps,
+        vel = estimate.vel_mps if estimate.control_vel_mps is None else estimate.control_vel_mps
+        terms: PidTerms = self.pid.update(setpoint_m, alt, dt_s, measurement_rate=vel,
                                           integrate=integrate, slew_per_s=rate_mps)
         tilt = self._tilt(roll_rad, pitch_rad)
         thrust = p.mass_kg * (GRAVITY_MPS2 + terms.out) / tilt
@@ -150,7 +152,7 @@ class AltitudeController:
             self._learn_hover(motor * tilt, terms, estimate, dt_s)
         return AltControlOutput(
             setpoint_m=terms.shaped_target,
-            alt_m=estimate.alt_m,
+            alt_m=alt,
             error_m=terms.error,
             p=terms.p,
             i=terms.i,
@@ -181,3 +183,8 @@ class AltitudeController:
         shift = (new - self.hover_throttle) * scale
         self.pid.shift_integrator(-shift)
         self.hover_throttle = new
+
+
+def _flown_alt(est: AltEstimate) -> float:
+    """The altitude the hold acts on: the estimate's control altitude when it has one."""
+    return est.alt_m if est.control_alt_m is None else est.control_alt_m

@@ -11,6 +11,12 @@ from dataclasses import dataclass, replace
 
 from firmware_link.records import Attitude, Imu, Rangefinder
 from gcs.estimation.catch_up import CatchUp, TickInputs, average_imu
+from gcs.estimation.control import (
+    control_correct,
+    control_follow,
+    control_predict,
+    control_start,
+)
 from gcs.estimation.inputs import sonar_altitude_m, vertical_accel_up_mps2
 
 
@@ -46,11 +52,9 @@ class EstimatorParams:
     # changed value is a new reading (as all were before whole centimetres).
     sonar_doubt_s: float = 5.0
     # Per-sample vertical acceleration noise the Kalman filter assumes: the vibration on a 40 Hz
-    # RAW_IMU (~0.5 m/s²) and some margin. Against the sonar this puts the filter's bandwidth,
-    # (q/r)^¼ ≈ 7 rad/s, above the altitude loop's crossover (~4.6 rad/s). With 0.5 m/s² and a
-    # 2 cm sonar σ it sat at 4.2 rad/s, on the crossover, where the D term turned ~4 cm/s of
-    # velocity error into motion. Trusting the accelerometer even less would help the hold
-    # further but widens the gates while coasting, and lets more carpet echoes through.
+    # RAW_IMU (~0.5 m/s²) and some margin; (q/r)^¼ ≈ 7 rad/s against the sonar. The hold flies
+    # on its own faster filter (control_accel_sigma_mps2): trusting the accelerometer less here
+    # would widen the gates while coasting and let more carpet echoes through.
     accel_sigma_mps2: float = 0.7
     bias_walk_mps2_per_sqrt_s: float = 0.01
     initial_bias_sigma_mps2: float = 0.2
@@ -82,12 +86,15 @@ class EstimatorParams:
     # about now: through a telemetry gap the filter assumes no acceleration instead of
     # integrating the last sample's noise and vibration (±0.6 m/s²) for the whole gap.
     imu_stale_s: float = 0.06
+    # The hold's own filter (gcs/estimation/control.py): acceleration noise that puts its
+    # bandwidth on the sonar, well above the altitude loop's crossover
+    control_accel_sigma_mps2: float = 4.0
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.sonar_min_m < self.sonar_max_m:
             raise ValueError("need 0 <= sonar_min_m < sonar_max_m")
         positive = ("sonar_sigma_m", "accel_sigma_mps2", "gate_sigma", "gate_m",
-                    "complementary_tc_s", "max_dt_s")
+                    "complementary_tc_s", "max_dt_s", "control_accel_sigma_mps2")
         for name in positive:
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"{name} must be > 0")
@@ -129,6 +136,9 @@ class AltEstimate:
     coasting: bool  # no accepted sonar for longer than stale_after_s
     alt_sigma_m: float  # the filter's own standard deviation, nan when it has none
     rejected_total: int
+    # what the altitude hold flies on (gcs/estimation/control.py); None: alt_m and vel_mps
+    control_alt_m: float | None = None
+    control_vel_mps: float | None = None
 
 
 class AltEstimator(ABC):
@@ -165,6 +175,7 @@ class AltEstimator(ABC):
         self._reject_run_start_s = 0.0
         self._reject_seen_s = -math.inf  # last rejected reading, or a repeat of it
         self._catch_up = CatchUp()
+        self._control = control_start(0.0, 0.0, 0.1**2)
 
     @abstractmethod
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
@@ -213,6 +224,7 @@ class AltEstimator(ABC):
             a = self._acc_up - self._state()[2]
             self._repeat_move_m += (self._repeat_vel_mps + 0.5 * a * dt) * dt
             self._repeat_vel_mps += a * dt
+            control_predict(self._control, a, dt, p.control_accel_sigma_mps2)
         alt_before = self._state()[0]
         self._history.append((t_s, alt_before))
         while self._history[0][0] < t_s - p.history_s:
@@ -244,6 +256,14 @@ class AltEstimator(ABC):
             self._baro(baro_alt_m, coasting=t_s - self._last_sonar_t_s > p.stale_after_s)
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
+        ctl = self._control
+        if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or age > p.stale_after_s
+                or at_rest or not self._initialised):
+            control_follow(ctl, alt, vel, sigma)
+        elif status is SonarStatus.USED:
+            # the reading as the estimator took it: late echoes moved to the present
+            control_correct(ctl, alt_before + innovation,
+                            p.sonar_sigma_m**2 + p.sonar_resolution_m**2 / 12.0)
         return AltEstimate(
             t_s=t_s,
             alt_m=alt,
@@ -257,6 +277,8 @@ class AltEstimator(ABC):
             coasting=age > p.stale_after_s,
             alt_sigma_m=sigma,
             rejected_total=self._rejected_total,
+            control_alt_m=ctl[0],
+            control_vel_mps=ctl[1],
         )
 
     def update_tick(
