@@ -75,6 +75,9 @@ class Direction(enum.Enum):
 
 
 RAW_TOPICS = {Direction.RX: MAVLINK_RX_TOPIC, Direction.TX: MAVLINK_TX_TOPIC}
+# by member or value, without an Enum call on every frame
+_RAW_TOPIC_OF: dict[Direction | str, str] = {**RAW_TOPICS,
+                                             **{d.value: t for d, t in RAW_TOPICS.items()}}
 
 
 class _Kind(enum.Enum):
@@ -285,9 +288,11 @@ class Recorder:
     def put_raw(self, direction: Direction | str, t_s: float, data: bytes) -> None:
         """Queue one raw MAVLink frame, "rx" (from the vehicle) or "tx" (to it)."""
         try:
-            topic = RAW_TOPICS[Direction(direction)]
-        except ValueError as exc:
-            raise RecordingError(f"direction {direction!r}: expected 'rx' or 'tx'") from exc
+            topic = _RAW_TOPIC_OF.get(direction)
+        except TypeError:  # unhashable
+            topic = None
+        if topic is None:
+            raise RecordingError(f"direction {direction!r}: expected 'rx' or 'tx'")
         self._enqueue(_Kind.RAW, topic, t_s, bytes(data))
 
     def event(self, t_s: float, level: LogLevel | int | str, text: str) -> None:
