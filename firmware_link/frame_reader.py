@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
@@ -161,14 +161,14 @@ class FrameReader:
         t = unpack(payload[:size])
         d = attrs.copy()
         if arrays:
-            for name, first, count in layout:  # type: ignore[misc]
+            for name, first, count in cast(tuple[tuple[str, int, int], ...], layout):
                 d[name] = t[first] if count == 1 else list(t[first:first + count])
         else:
-            d.update(zip(layout, t, strict=True))
+            d.update(zip(cast(tuple[str, ...], layout), t, strict=True))
         d["_msgbuf"] = frame
         d["_payload"] = frame[6:-2]  # sic: decode's offset, whichever the header's length
         d["_crc"] = crc
         d["_header"] = _Header(msg_id, incompat, compat, mlen, seq, src, comp)
-        m = _new(cls)
+        m: Any = _new(cls)
         m.__dict__ = d
         return m

@@ -76,8 +76,8 @@ class Direction(enum.Enum):
 
 RAW_TOPICS = {Direction.RX: MAVLINK_RX_TOPIC, Direction.TX: MAVLINK_TX_TOPIC}
 # by member or value, without an Enum call on every frame
-_RAW_TOPIC_OF: dict[Direction | str, str] = {**RAW_TOPICS,
-                                             **{d.value: t for d, t in RAW_TOPICS.items()}}
+_RAW_TOPIC_OF: dict[Direction | str, str] = {
+    **{d: t for d, t in RAW_TOPICS.items()}, **{d.value: t for d, t in RAW_TOPICS.items()}}
 
 
 class _Kind(enum.Enum):
