@@ -3,10 +3,10 @@
 Per vehicle a `StationSession` gives a 25 ms station loop with mocap position hold and PC
 altitude hold; the sessions come up in parallel and are checked before anything arms. The team
 (`team.py`) arms every vehicle together, takes off together, then the planner runs step by step
-(`vehicle_planners.py`, `vehicle_radiation.py`): read the six IR sensors (and, for radiation,
-integrate the detector for a dwell), ask the planner for the next set position, hold it until
-within tolerance for a short settle time (or a timeout), and repeat; then every vehicle lands
-(PC descent, LAND mode touch-down, disarm).
+(`loop_epbha.py` and `loop_radiation.py` through a `TeamPort`, the kinematic world's loops too;
+`vehicle_flock.py`): read the six IR sensors (and, for radiation, integrate the detector), ask
+the planner for the next set position, hold it until within tolerance for a short settle time
+(or a timeout), and repeat; then every vehicle lands (PC descent, LAND mode touch-down, disarm).
 
 Collisions are counted afterwards against the SITL's ground truth (`truth_check`), from take-off
 until landing begins: touching down on the goal box is the point of the EPBHA mission.
@@ -23,24 +23,24 @@ from typing import TYPE_CHECKING, Any
 from gcs.errors import UsageError
 from gcs.mission.craft import Craft, CraftPhase
 from gcs.mission.events import EventLog, MissionEvent
-from gcs.mission.off_mission import off_mission
+from gcs.mission.loop_epbha import fly_epbha
+from gcs.mission.loop_radiation import fly_radiation
 from gcs.mission.options import RunOptions
+from gcs.mission.outcome import mission_report
 from gcs.mission.planner_params import PlannerSetup
 from gcs.mission.plot import write_radiation_products
 from gcs.mission.recording import SUMMARY, MissionRecording
-from gcs.mission.report import MissionReport, MissionStatus, RunMode
+from gcs.mission.report import MissionReport, RunMode
 from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.team import Team
+from gcs.mission.team_port import TeamPort
 from gcs.mission.truth_check import check_contacts
-from gcs.mission.vehicle_planners import fly_epbha, fly_flock, path_length_m
-from gcs.mission.vehicle_radiation import fly_radiation
+from gcs.mission.vehicle_flock import fly_flock
 from gcs.mission.world import MissionWorld
 from gcs.session import SessionOptions, StationSession
 
 if TYPE_CHECKING:
     from gcs.lockstep_session import LockstepSession
-
-__all__ = ["off_mission", "run_on_vehicles"]
 
 Progress = Callable[[str], None]
 
@@ -93,14 +93,15 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         f.event(MissionEvent.SESSION_READY, detail=f"{len(crafts)} vehicle(s)")
         try:
             hover = f.take_off()
+            first = hover[sysids[0]]
             if spec.planner is PlannerKind.EPBHA:
-                outcome = fly_epbha(f, setup, hover)
+                outcome = fly_epbha(TeamPort(f), setup, first)
             elif spec.planner is PlannerKind.FLOCKING:
                 outcome = fly_flock(f, setup, hover)
             else:
                 truth = (mw.radiation_field(height_m=spec.takeoff_alt_m)
                          if options.truth and mw.has_truth else None)
-                outcome = fly_radiation(f, setup, hover, truth)
+                outcome = fly_radiation(TeamPort(f), setup, first, truth)
             f.land()  # whatever `flight.land` says: closing the session releases the sticks
         except BaseException:
             for c in crafts.values():  # all at once; leaving the session waits for each LAND
@@ -108,23 +109,17 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
             raise
         collisions, truth_metrics = (_truth_books(crafts, mw) if options.truth else
                                      (0, {"collision_source": "none"}))
-        status, reason = outcome.status, outcome.reason
-        if collisions and status is MissionStatus.REACHED:
-            status, reason = MissionStatus.FAILED, f"{reason}, but {collisions} collisions"
-        metrics = {**outcome.metrics, **truth_metrics, "speedup": speedup,
-                   "clock": "lockstep" if options.lockstep else "wall"}
+        books = {**truth_metrics, "speedup": speedup,
+                 "clock": "lockstep" if options.lockstep else "wall"}
         if len(sysids) > 1:
-            metrics["recordings"] = [r.path.as_posix() for s in sysids
-                                     if (r := session.vehicles[s].recorder) is not None]
-        report = MissionReport(
-            mission=spec.name, planner=spec.planner.value, mode=RunMode.VEHICLE, status=status,
-            reason=reason, collisions=collisions,
-            path_length_m=(metrics.get("team_path_length_m") if len(sysids) > 1
-                           else path_length_m(outcome.path_n)) or 0.0,
-            duration_s=f.elapsed_s(), wall_s=time.monotonic() - wall0, steps=outcome.steps,
-            recording=rec.path, metrics=metrics)
-        if spec.planner is PlannerKind.RADIATION:
-            report.path_length_m = float(metrics.get("path_length_m", report.path_length_m))
+            books["recordings"] = [r.path.as_posix() for s in sysids
+                                   if (r := session.vehicles[s].recorder) is not None]
+        path_length = (outcome.metrics.get("team_path_length_m") if len(sysids) > 1
+                       else outcome.metrics.get("path_length_m"))
+        report = mission_report(spec, RunMode.VEHICLE, outcome, collisions=collisions,
+                                books=books, duration_s=f.elapsed_s(),
+                                wall_s=time.monotonic() - wall0, recording=rec.path,
+                                path_length=path_length)
         rec.put(SUMMARY, time.monotonic(), report.to_dict())
     if spec.planner is PlannerKind.RADIATION and outcome.products is not None \
             and outcome.products[1] is not None:

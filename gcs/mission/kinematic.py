@@ -8,7 +8,6 @@ what `duration_s` reports; the recording is stamped on that timeline too.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -16,28 +15,21 @@ from typing import Any
 import numpy as np
 
 from gcs.errors import UsageError
+from gcs.mission.kinematic_port import KinematicPort
+from gcs.mission.loop_epbha import fly_epbha
+from gcs.mission.loop_radiation import fly_radiation
+from gcs.mission.outcome import mission_report
 from gcs.mission.planner_params import PlannerSetup
-from gcs.mission.radiation_maps import finish_radiation, is_reached
-from gcs.mission.recording import (
-    SAMPLE_RADIATION,
-    STEP_EPBHA,
-    STEP_FLOCK,
-    MissionRecording,
-    epbha_payload,
-    flock_payload,
-    radiation_payload,
-)
+from gcs.mission.recording import STEP_FLOCK, MissionRecording, flock_payload
 from gcs.mission.report import MissionReport, MissionStatus, RunMode
 from gcs.mission.spec import MissionSpec
 from gcs.mission.world import MissionWorld
-from planners.epbha import Epbha, Status
 from planners.flock_scenes import FlockScene
 from planners.flock_sim import FlockRunParams, run_flock
 from planners.flocking import FlockMission, FlockPlanner, FlockStep
 from planners.geometry import Vec3
 from planners.kinematic import KinematicParams, KinematicSim
 from planners.proximity import ProximityParams, ProximityReading
-from planners.radiation import RadiationMapper, take_reading
 
 NOMINAL_SPEED_MPS = 0.5  # a 0.1 m grid step every 0.2 s, as the flock runner assumes
 RADIATION_SPEED_MPS = 1.0
@@ -75,63 +67,20 @@ def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
     wall0 = time.monotonic()
     t0 = time.monotonic()
     params = setup.params
-    goal = spec.goal_n
-    assert goal is not None
     start = _at_altitude(start_of(spec, mw, 0), spec.takeoff_alt_m)
-    rng = np.random.default_rng(setup.seed)
     prox = ProximityParams(range_m=params.sensor_range_m, cone_deg=params.sensor_cone_deg,
                            noise_sigma_m=setup.noise_sigma_m)
-    sim = KinematicSim(mw.world, start, KinematicParams(), prox, rng)
-    planner = Epbha(params, goal, start)
-    dt = params.step_m / NOMINAL_SPEED_MPS
+    sim = KinematicSim(mw.world, start, KinematicParams(), prox,
+                       np.random.default_rng(setup.seed))
     rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
-    status, reason = MissionStatus.FAILED, f"no goal after {setup.max_steps} steps"
-    obstacles: dict[str, int] = {}
-    k = 0
-    for k in range(setup.max_steps + 1):
-        t = t0 + k * dt
-        reading = sim.sense()
-        decision = planner.step(sim.pos_n, reading)
-        rec.put(STEP_EPBHA, t, epbha_payload(k, sim.pos_n, reading, decision,
-                                             planner.cost_evaluations))
-        rec.pose(t, sim.pos_n)
-        obstacles[decision.obstacle.value] = obstacles.get(decision.obstacle.value, 0) + 1
-        if progress is not None:
-            progress(_epbha_line(k, sim.pos_n, decision))
-        if decision.status is Status.REACHED:
-            status, reason = MissionStatus.REACHED, "goal reached"
-            break
-        if decision.status is Status.DEADLOCK:
-            reason = decision.reason.value
-            break
-        if k == setup.max_steps:
-            break
-        sim.move_to(decision.next_pos_n)
-    if status is MissionStatus.REACHED and math.dist(sim.pos_n, goal) > spec.goal_tolerance_m:
-        status = MissionStatus.FAILED
-        reason = (f"planner stopped {math.dist(sim.pos_n, goal):.2f} m from the goal "
-                  f"(tolerance {spec.goal_tolerance_m} m)")
-    path_len = sum(math.dist(a, b) for a, b in zip(sim.path, sim.path[1:], strict=False))
+    port = KinematicPort(spec, rec, {spec.vehicles[0].sysid: sim}, t0,
+                         step_s=params.step_m / NOMINAL_SPEED_MPS, progress=progress)
+    outcome = fly_epbha(port, setup, start)
     collisions, books = _books(sim.collisions, truth)
-    return MissionReport(
-        mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC, status=status,
-        reason=reason, collisions=collisions, path_length_m=path_len,
-        duration_s=k * dt, wall_s=time.monotonic() - wall0, steps=len(sim.path) - 1,
-        recording=rec.path,
-        metrics={
-            **books,
-            "cost_evaluations": planner.cost_evaluations,
-            "min_clearance_m": sim.min_clearance_m if truth else None,
-            "final_pos_n": list(sim.pos_n),
-            "goal_error_m": math.dist(sim.pos_n, goal),
-            "obstacle_steps": obstacles,
-        },
-    )
-
-
-def _epbha_line(k: int, pos: Vec3, d: Any) -> str:
-    return (f"step {k:4d} at ({pos[0]:+.2f}, {pos[1]:+.2f}, alt {-pos[2]:.2f}) "
-            f"{d.status.value:8s} {d.reason.value} [{d.obstacle.value}]")
+    books["min_clearance_m"] = sim.min_clearance_m if truth else None
+    return mission_report(spec, RunMode.KINEMATIC, outcome, collisions=collisions,
+                          books=books, duration_s=port.elapsed_s(),
+                          wall_s=time.monotonic() - wall0, recording=rec.path)
 
 
 class _RecordedFlock:
@@ -239,45 +188,24 @@ def run_radiation_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerS
     """The contour mapper over the world's analytic field, perfect position hold.
 
     The field is simulated whatever `truth` says; the map is scored against it only when the
-    run may know it (`truth`, and a world that has [[sources]])."""
+    run may know it (`truth`, and a world that has [[sources]]). A sample point outside the
+    room counts as a collision."""
     wall0 = time.monotonic()
     t0 = time.monotonic()
     p = setup.params
     field = mw.radiation_field(height_m=spec.takeoff_alt_m)
     known = field if truth and mw.has_truth else None
-    rng = np.random.default_rng(setup.seed)
-    mapper = RadiationMapper(p, max_samples=setup.max_samples)
-    pos = p.clip(np.asarray(start_of(spec, mw, 0)[:2], dtype=float))
-    path = [pos]
-    t = 0.0
-    k = 0
+    xy = p.clip(np.asarray(start_of(spec, mw, 0)[:2], dtype=float))
+    start: Vec3 = (float(xy[0]), float(xy[1]), -spec.takeoff_alt_m)
+    sim = KinematicSim(mw.world, start)
     rec.scene(t0, mw.world.room, mw.world.obstacles)
-    while True:
-        cps, dwell_s = take_reading(field, pos, rng, p)
-        t += dwell_s
-        decision = mapper.step(pos, cps, dwell_s)
-        rec.put(SAMPLE_RADIATION, t0 + t,
-                {**radiation_payload(k, pos, cps, decision), "dwell_s": dwell_s})
-        rec.pose(t0 + t, (float(pos[0]), float(pos[1]), -spec.takeoff_alt_m))
-        if progress is not None:
-            progress(f"sample {k:4d} at ({pos[0]:+6.2f}, {pos[1]:+6.2f}) {cps:8.1f} cps "
-                     f"{decision.phase.value:11s} {decision.reason}")
-        if decision.done:
-            break
-        nxt = np.asarray(decision.next_pos_n, dtype=float)
-        t += float(np.linalg.norm(nxt - pos)) / RADIATION_SPEED_MPS
-        pos = nxt
-        path.append(pos)
-        k += 1
-    path_xy = np.array(path)
-    metrics, products = finish_radiation(mapper, known, path_xy, rec, t0 + t)
-    status, why = is_reached(metrics, setup.min_iou)
-    outside = sum(not mw.world.in_room((float(q[0]), float(q[1]), -spec.takeoff_alt_m))
-                  for q in path_xy)
-    report = MissionReport(
-        mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC,
-        status=status, reason=why,
-        collisions=int(outside), path_length_m=metrics["path_length_m"], duration_s=t,
-        wall_s=time.monotonic() - wall0, steps=k, recording=rec.path, metrics=metrics,
-    )
-    return report, (known, products)
+    port = KinematicPort(spec, rec, {spec.vehicles[0].sysid: sim}, t0,
+                         speed_mps=RADIATION_SPEED_MPS, field=field,
+                         rng=np.random.default_rng(setup.seed), progress=progress)
+    outcome = fly_radiation(port, setup, start, known)
+    outside = sum(not mw.world.in_room(q) for q in outcome.path_n)
+    report = mission_report(spec, RunMode.KINEMATIC, outcome, collisions=int(outside),
+                            books={}, duration_s=port.elapsed_s(),
+                            wall_s=time.monotonic() - wall0, recording=rec.path,
+                            path_length=outcome.metrics["path_length_m"])
+    return report, outcome.products

@@ -1,7 +1,5 @@
-"""The radiation mapper flown on a vehicle: fly through a sample point, count, ask for the next.
-
-The mapper is given where the vehicle was while the detector counted (the mean mocap position),
-and its mission stops when the autopilot takes the vehicle over (a battery failsafe's LAND, say).
+"""Radiation samples counted on the move by a MAVLink vehicle: where it is sent, and where a
+count is attributed (the radiation loop's `fly_to_sample` and `count` on a `TeamPort`).
 """
 
 from __future__ import annotations
@@ -11,19 +9,11 @@ import math
 import numpy as np
 
 from gcs.mission.craft import Craft
-from gcs.mission.events import MissionEvent
-from gcs.mission.off_mission import off_mission
-from gcs.mission.planner_params import PlannerSetup
-from gcs.mission.radiation_maps import finish_radiation, is_reached
-from gcs.mission.recording import SAMPLE_RADIATION, radiation_payload
-from gcs.mission.report import MissionStatus
+from gcs.mission.port import Count
 from gcs.mission.team import Team
-from gcs.mission.vehicle_planners import Outcome
 from planners.geometry import Vec3
-from planners.radiation import RadiationMapper, RadiationMapperParams
-from planners.radiation_field import RadiationField
+from planners.radiation import RadiationMapperParams
 
-TRAVEL_MPS = 0.5  # radiation legs: the timeout grows with the leg at this speed
 # Radiation samples are counted on the move. Braking to every sample point and waiting there
 # until the vehicle was slow spent 2.5 s a sample between counts (1.5 s on the 0.5-1 m legs of
 # the fans and the contour), 400 s of a 490 s flight. The set position is put this far past the
@@ -41,15 +31,15 @@ SAMPLE_SPEED_WINDOW_S = 0.25
 SAMPLE_POLL_S = 0.05  # station time: the same sampling however fast the SITL runs
 
 
-def _fly_to_sample(f: Team, craft: Craft, target: Vec3, p: RadiationMapperParams,
+def fly_to_sample(f: Team, craft: Craft, target: Vec3, p: RadiationMapperParams,
                    count_s: float, timeout_s: float) -> bool:
     """Fly through `target` until counting there should start; False on timeout.
 
-    A reading is attributed to where the vehicle was while counting (see `_dwell`), so it need
-    not stop at the set position: the mapper is told where each sample was taken. Counting over
-    a path of length L and attributing it to the path's mean position errs by about L²/24 of
-    the field's relative curvature (<= 2/m² at 1 m height): 2 % for a 0.5 m count, less than
-    the counting noise.
+    A reading is attributed to where the vehicle was while counting (see `count_on_the_move`),
+    so it need not stop at the set position: the mapper is told where each sample was taken.
+    Counting over a path of length L and attributing it to the path's mean position errs by
+    about L²/24 of the field's relative curvature (<= 2/m² at 1 m height): 2 % for a 0.5 m
+    count, less than the counting noise.
     """
     here = craft.position_n()
     leg = np.subtract(target[:2], here[:2])
@@ -81,17 +71,8 @@ def _fly_to_sample(f: Team, craft: Craft, target: Vec3, p: RadiationMapperParams
         f.clock.sleep_until(now + SAMPLE_POLL_S)
 
 
-def _count_s(cps: float, p: RadiationMapperParams) -> float:
-    """How long the detector will count at a rate like `cps` (whole windows, at most the
-    dwell): the next sample's rate is about the last one's."""
-    if p.target_counts <= 0.0 or not math.isfinite(cps) or cps <= 0.0:
-        return p.dwell_s
-    w = p.detector_window_s
-    return min(p.dwell_s, w * math.ceil(p.target_counts / (cps * w)))
-
-
-def _dwell(f: Team, craft: Craft, p: RadiationMapperParams) -> tuple[float, float, Vec3]:
-    """Integrate the detector from now: (mean counts/s, seconds counted, where it counted).
+def count_on_the_move(f: Team, craft: Craft, p: RadiationMapperParams) -> Count:
+    """Integrate the detector from now: mean counts/s, seconds counted, where it counted.
 
     Counting stops at `p.dwell_s`, or once `p.target_counts` are in (the detector reports
     counts/s over windows of `p.detector_window_s`). The vehicle may be moving: each report is
@@ -119,50 +100,4 @@ def _dwell(f: Team, craft: Craft, p: RadiationMapperParams) -> tuple[float, floa
              if (w := [q for t, q in trail if r.t_s - p.detector_window_s < t <= r.t_s])]
     mean = np.mean(np.array(means if means else seen), axis=0)
     counted_s = len(got) * p.detector_window_s if got else p.dwell_s
-    return cps, counted_s, (float(mean[0]), float(mean[1]), float(mean[2]))
-
-
-def fly_radiation(f: Team, setup: PlannerSetup, hover: dict[int, Vec3],
-               truth: RadiationField | None) -> Outcome:
-    """Map the floor; score the map against `truth` when the run may know it (else None)."""
-    spec = f.spec
-    v = next(iter(f.crafts))
-    craft = f.crafts[v]
-    p = setup.params
-    alt = spec.takeoff_alt_m
-    mapper = RadiationMapper(p, max_samples=setup.max_samples)
-    here = p.clip(np.asarray(hover[v][:2], dtype=float))
-    target: Vec3 = (float(here[0]), float(here[1]), -alt)
-    f.go({v: target}, timeout_s=spec.step_timeout_s + math.dist(hover[v], target) / TRAVEL_MPS)
-    path: list[Vec3] = [target]
-    k = 0
-    stopped: str | None = None
-    while True:
-        cps, counted_s, m = _dwell(f, craft, p)
-        stopped = off_mission(craft.snapshot(), f.elapsed_s())
-        if stopped is not None:
-            f.event(MissionEvent.SAMPLE_DROPPED, v, f"sample {k}: {stopped}")
-            break
-        decision = mapper.step((m[0], m[1]), cps, counted_s)
-        t = f.clock.now_s()
-        f.rec.put(SAMPLE_RADIATION, t,
-                  {**radiation_payload(k, m, cps, decision), "dwell_s": counted_s})
-        f.rec.pose(t, m)
-        f.say(f"sample {k:4d} at ({m[0]:+6.2f}, {m[1]:+6.2f}) {cps:8.1f} cps "
-              f"{decision.phase.value:11s} {decision.reason}")
-        if decision.done or f.over_budget():
-            break
-        nxt: Vec3 = (float(decision.next_pos_n[0]), float(decision.next_pos_n[1]), -alt)
-        leg = math.dist(m, nxt)
-        _fly_to_sample(f, craft, nxt, p, _count_s(cps, p),
-                       spec.step_timeout_s + leg / TRAVEL_MPS)
-        path.append(nxt)
-        k += 1
-    path_xy = np.array([(q[0], q[1]) for q in path])
-    metrics, products = finish_radiation(mapper, truth, path_xy, f.rec, f.clock.now_s())
-    status, why = is_reached(metrics, setup.min_iou)
-    if stopped is not None:
-        status, why = MissionStatus.FAILED, f"{stopped} at sample {k}"
-    elif f.over_budget() and not mapper.done:
-        status, why = MissionStatus.FAILED, f"mission time {spec.max_duration_s:g} s spent"
-    return Outcome(status, why, k, path, metrics, (truth, products))
+    return Count(cps, counted_s, (float(mean[0]), float(mean[1]), float(mean[2])))

@@ -13,6 +13,7 @@ import pytest
 from firmware_link.records import Radiation
 from gcs.clock import SimClock
 from gcs.mission import vehicle_radiation as vr
+from gcs.mission.loop_radiation import count_time_s
 from planners.geometry import Vec3
 from planners.radiation import RadiationMapperParams
 
@@ -74,7 +75,8 @@ def team(clock: SimClock) -> Any:
 def test_a_reading_on_the_move_is_attributed_to_the_mean_position_over_its_windows() -> None:
     clock = SimClock(1.05)
     craft = MovingCraft(clock, start=(0.0, 0.0))  # passing x = 1.05 m at 1 m/s
-    cps, counted_s, at = vr._dwell(team(clock), craft, PARAMS)  # type: ignore[arg-type]
+    c = vr.count_on_the_move(team(clock), craft, PARAMS)  # type: ignore[arg-type]
+    cps, counted_s, at = c.counts_per_s, c.counted_s, c.at_n
     # 200 counts a window: four windows, (1.0, 1.2] to (1.6, 1.8], their centres 1.1 to 1.7 m
     assert cps == 1000.0 and counted_s == pytest.approx(0.8)
     assert at[0] == pytest.approx(1.4, abs=0.01) and at[1:] == (0.0, -1.0)
@@ -84,9 +86,9 @@ def test_the_vehicle_is_sent_past_the_sample_point_and_counts_before_it() -> Non
     clock = SimClock(0.0)
     craft = MovingCraft(clock, start=(0.0, 0.0))
     craft.command((0.0, 0.0, -1.0))
-    count_s = vr._count_s(1000.0, PARAMS)
+    count_s = count_time_s(1000.0, PARAMS)
     assert count_s == pytest.approx(0.8)
-    assert vr._fly_to_sample(team(clock), craft, (2.0, 0.0, -1.0), PARAMS,  # type: ignore[arg-type]
+    assert vr.fly_to_sample(team(clock), craft, (2.0, 0.0, -1.0), PARAMS,  # type: ignore[arg-type]
                              count_s, timeout_s=10.0)
     assert craft.set_n == pytest.approx((2.0 + vr.SAMPLE_THROUGH_M, 0.0))
     # half the count's travel (0.4 m at 1 m/s) before the point: the count is centred on it
@@ -97,12 +99,12 @@ def test_at_the_floors_edge_the_vehicle_is_held_at_the_sample_point() -> None:
     clock = SimClock(0.0)
     craft = MovingCraft(clock, start=(8.0, 0.0))
     craft.command((8.0, 0.0, -1.0))
-    assert vr._fly_to_sample(team(clock), craft, (9.3, 0.0, -1.0), PARAMS,  # type: ignore[arg-type]
-                             vr._count_s(50.0, PARAMS), timeout_s=10.0)
+    assert vr.fly_to_sample(team(clock), craft, (9.3, 0.0, -1.0), PARAMS,  # type: ignore[arg-type]
+                             count_time_s(50.0, PARAMS), timeout_s=10.0)
     assert craft.set_n == pytest.approx((PARAMS.x_max_m, 0.0))
 
 
 def test_counting_time_follows_the_last_rate() -> None:
-    assert vr._count_s(2500.0, PARAMS) == pytest.approx(0.4)  # 800 counts in two windows
-    assert vr._count_s(50.0, PARAMS) == PARAMS.dwell_s  # background: the whole dwell
-    assert vr._count_s(math.nan, PARAMS) == PARAMS.dwell_s
+    assert count_time_s(2500.0, PARAMS) == pytest.approx(0.4)  # 800 counts in two windows
+    assert count_time_s(50.0, PARAMS) == PARAMS.dwell_s  # background: the whole dwell
+    assert count_time_s(math.nan, PARAMS) == PARAMS.dwell_s

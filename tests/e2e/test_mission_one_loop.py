@@ -1,0 +1,94 @@
+"""One mission file flown in the kinematic world and on the lockstep SITL goes through one
+planner loop: both reports name the same loop, and their step records have the same shape."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from gcs.mission import recording as topics
+from logs import open_recording
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _mission(tmp_path: Path, name: str, edits: dict[str, str]) -> Path:
+    text = (ROOT / "missions" / f"{name}.toml").read_text()
+    for old, new in edits.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    f = tmp_path / f"{name}.toml"
+    f.write_text(text.replace('"../worlds/', f'"{ROOT}/worlds/'))
+    return f
+
+
+def _run(mission: Path, out: Path, mode: str) -> dict[str, Any]:
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "mission", "run", str(mission), mode, "--seed", "3",
+         "--json", "-q", "-o", str(out)],
+        capture_output=True, text=True, timeout=200, check=False)
+    lines = proc.stdout.strip().splitlines()
+    assert lines, f"{mode}: exit {proc.returncode}: {proc.stderr.strip()}"
+    return json.loads(lines[-1])
+
+
+def _shape(value: Any, at: str, into: dict[str, set[str]]) -> None:
+    """Every key path of a record with the kinds of value found there (None: any kind)."""
+    if isinstance(value, dict):
+        into.setdefault(at, set()).add("object")
+        for k, v in value.items():
+            _shape(v, f"{at}.{k}", into)
+    elif isinstance(value, list):
+        into.setdefault(at, set()).add("list")
+        for v in value:
+            _shape(v, f"{at}[]", into)
+    elif value is None:
+        into.setdefault(at, set())
+    else:
+        kind = "number" if isinstance(value, int | float) and not isinstance(value, bool) \
+            else type(value).__name__
+        into.setdefault(at, set()).add(kind)
+
+
+def _steps(d: dict[str, Any], topic: str) -> tuple[int, dict[str, set[str]]]:
+    shapes: dict[str, set[str]] = {}
+    n = 0
+    for _, _, m in open_recording(d["recording"]).messages([topic]):
+        _shape(m, "", shapes)
+        n += 1
+    return n, shapes
+
+
+@pytest.mark.e2e
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize(("name", "edits", "topic", "loop", "metrics"), [
+    ("epbha_table", {}, topics.STEP_EPBHA, "epbha",
+     {"cost_evaluations", "final_pos_n", "goal_error_m", "obstacle_steps"}),
+    # the prospecting lattice and a few samples past it: a short flight, every kind of record
+    ("radiation_3src", {"max_samples = 400": "max_samples = 12"}, topics.SAMPLE_RADIATION,
+     "radiation", {"samples", "iou", "hotspots", "mapper_status", "path_length_m"}),
+])
+def test_kinematic_and_lockstep_runs_of_one_mission_share_the_planner_loop(
+        tmp_path: Path, name: str, edits: dict[str, str], topic: str, loop: str,
+        metrics: set[str]) -> None:
+    mission = _mission(tmp_path, name, edits)
+    kin = _run(mission, tmp_path / "kinematic", "--kinematic")
+    sitl = _run(mission, tmp_path / "lockstep", "--lockstep")
+    assert (kin["mode"], sitl["mode"]) == ("kinematic", "vehicle")
+    assert sitl["clock"] == "lockstep"
+    assert kin["planner_loop"] == sitl["planner_loop"] == loop
+    assert metrics <= set(kin) and metrics <= set(sitl)
+    assert kin["status"] == sitl["status"], (kin["reason"], sitl["reason"])
+    n_kin, kin_shape = _steps(kin, topic)
+    n_sitl, sitl_shape = _steps(sitl, topic)
+    # a record per planner step, the last one's too (the goal found, the budget spent)
+    assert n_kin == kin["steps"] + 1 and n_sitl == sitl["steps"] + 1
+    assert set(kin_shape) == set(sitl_shape), set(kin_shape) ^ set(sitl_shape)
+    for path, kinds in kin_shape.items():
+        other = sitl_shape[path]
+        assert not kinds or not other or kinds == other, (path, kinds, other)
