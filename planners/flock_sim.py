@@ -177,7 +177,7 @@ def _closest_approach(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.nda
     return float(np.linalg.norm(d0 + t * dv))
 
 
-def _pairwise_min(prev: np.ndarray, new: np.ndarray) -> float:
+def pairwise_min_m(prev: np.ndarray, new: np.ndarray) -> float:
     """Minimum pairwise distance over one step of linear moves (exact between the steps)."""
     n = len(prev)
     d_end = np.linalg.norm(new[:, None, :] - new[None, :, :], axis=2) + np.eye(n) * 1e9
@@ -258,7 +258,7 @@ def run_flock(
             sims[v].move_to(out.setpoints_n[v])
         new = np.array([sims[v].pos_n for v in ids], dtype=float)
         if n_vehicles > 1:
-            step_min = _pairwise_min(prev, new)
+            step_min = pairwise_min_m(prev, new)
             min_sep = min(min_sep, step_min)
             d_end = np.linalg.norm(new[:, None] - new[None], axis=2)
             now = {

@@ -3,8 +3,8 @@
 Per vehicle a `StationSession` gives a 25 ms station loop with mocap position hold and PC
 altitude hold; the sessions come up in parallel and are checked before anything arms. The team
 (`team.py`) arms every vehicle together, takes off together, then the planner runs step by step
-(`loop_epbha.py` and `loop_radiation.py` through a `TeamPort`, the kinematic world's loops too;
-`vehicle_flock.py`): read the six IR sensors (and, for radiation, integrate the detector), ask
+(`loop_epbha.py`, `loop_flock.py`, `loop_radiation.py` through a `TeamPort`, the kinematic
+world's loops too): read the six IR sensors (and, for radiation, integrate the detector), ask
 the planner for the next set position, hold it until within tolerance for a short settle time
 (or a timeout), and repeat; then every vehicle lands (PC descent, LAND mode touch-down, disarm).
 
@@ -24,6 +24,7 @@ from gcs.errors import UsageError
 from gcs.mission.craft import Craft, CraftPhase
 from gcs.mission.events import EventLog, MissionEvent
 from gcs.mission.loop_epbha import fly_epbha
+from gcs.mission.loop_flock import fly_flock
 from gcs.mission.loop_radiation import fly_radiation
 from gcs.mission.options import RunOptions
 from gcs.mission.outcome import mission_report
@@ -35,7 +36,6 @@ from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.team import Team
 from gcs.mission.team_port import TeamPort
 from gcs.mission.truth_check import check_contacts
-from gcs.mission.vehicle_flock import fly_flock
 from gcs.mission.world import MissionWorld
 from gcs.session import SessionOptions, StationSession
 
@@ -97,7 +97,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
             if spec.planner is PlannerKind.EPBHA:
                 outcome = fly_epbha(TeamPort(f), setup, first)
             elif spec.planner is PlannerKind.FLOCKING:
-                outcome = fly_flock(f, setup, hover)
+                outcome = fly_flock(TeamPort(f), setup, hover)
             else:
                 truth = (mw.radiation_field(height_m=spec.takeoff_alt_m)
                          if options.truth and mw.has_truth else None)

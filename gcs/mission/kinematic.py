@@ -1,9 +1,11 @@
 """Missions in the planners' kinematic world (the thesis's assumption of exact moves, §8.6).
 
-The same planners, the same six IR cones (with the mission's sensor noise) and the same goals
-as on a vehicle, but every set position is reached exactly, so a mission finishes in seconds.
-Mission time advances by one nominal step time per planner step (`NOMINAL_SPEED_MPS`), which is
-what `duration_s` reports; the recording is stamped on that timeline too.
+The same planner loops (`loop_epbha`, `loop_flock`, `loop_radiation`), the same six IR cones
+(with the mission's sensor noise) and the same goals as on a vehicle, but every set position is
+reached exactly (`KinematicPort`), so a mission finishes in seconds. Mission time advances by
+one nominal step time per obstacle-planner step (`NOMINAL_SPEED_MPS`), or by the radiation
+legs at `RADIATION_SPEED_MPS` and the counts, which is what `duration_s` reports; the
+recording is stamped on that timeline too.
 """
 
 from __future__ import annotations
@@ -17,19 +19,18 @@ import numpy as np
 from gcs.errors import UsageError
 from gcs.mission.kinematic_port import KinematicPort
 from gcs.mission.loop_epbha import fly_epbha
+from gcs.mission.loop_flock import fly_flock
 from gcs.mission.loop_radiation import fly_radiation
 from gcs.mission.outcome import mission_report
 from gcs.mission.planner_params import PlannerSetup
-from gcs.mission.recording import STEP_FLOCK, MissionRecording, flock_payload
-from gcs.mission.report import MissionReport, MissionStatus, RunMode
+from gcs.mission.recording import MissionRecording
+from gcs.mission.report import MissionReport, RunMode
 from gcs.mission.spec import MissionSpec
 from gcs.mission.world import MissionWorld
-from planners.flock_scenes import FlockScene
-from planners.flock_sim import FlockRunParams, run_flock
-from planners.flocking import FlockMission, FlockPlanner, FlockStep
+from planners.flocking import FlockMission, FlockPlanner
 from planners.geometry import Vec3
 from planners.kinematic import KinematicParams, KinematicSim
-from planners.proximity import ProximityParams, ProximityReading
+from planners.proximity import ProximityParams
 
 NOMINAL_SPEED_MPS = 0.5  # a 0.1 m grid step every 0.2 s, as the flock runner assumes
 RADIATION_SPEED_MPS = 1.0
@@ -83,103 +84,47 @@ def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
                           wall_s=time.monotonic() - wall0, recording=rec.path)
 
 
-class _RecordedFlock:
-    """A FlockPlanner whose every step is recorded and reported (the runner drives it)."""
-
-    def __init__(self, inner: FlockPlanner, rec: MissionRecording, t0: float, dt_s: float,
-                 progress: Progress | None) -> None:
-        self.inner = inner
-        self.name = inner.name
-        self.rec = rec
-        self.t0 = t0
-        self.dt_s = dt_s
-        self.progress = progress
-
-    def step(self, step_index: int, positions_n: dict[int, Vec3],
-             readings: dict[int, ProximityReading]) -> FlockStep:
-        out = self.inner.step(step_index, positions_n, readings)
-        t = self.t0 + step_index * self.dt_s
-        self.rec.put(STEP_FLOCK, t, flock_payload(step_index, positions_n, readings, out))
-        for v, p in positions_n.items():
-            self.rec.pose(t, p, v)
-        if self.progress is not None and step_index % 10 == 0:
-            arrived = sum(self.inner.arrived().values())
-            err = out.formation_error_m
-            self.progress(f"step {step_index:4d} {out.phase.value:12s} arrived {arrived}/"
-                          f"{len(positions_n)} messages {out.messages_sent} formation error "
-                          + (f"{err:.2f} m" if err is not None else "-"))
-        return out
-
-    def final_targets_n(self) -> dict[int, Vec3]:
-        return self.inner.final_targets_n()
-
-    def start_positions_n(self, leader_start_n: Vec3) -> dict[int, Vec3]:
-        return self.inner.start_positions_n(leader_start_n)
-
-    def arrived(self) -> dict[int, bool]:
-        return self.inner.arrived()
-
-
-def flock_scene(spec: MissionSpec, mw: MissionWorld) -> FlockScene:
-    """The mission as a flock scene: the leader's start at take-off altitude, goals by index."""
-    goal = spec.goal_n
-    assert goal is not None
-    individual = dict(enumerate(spec.goals_n[1:]))
-    return FlockScene(spec.name, mw.world, _at_altitude(start_of(spec, mw, 0),
-                                                        spec.takeoff_alt_m), goal, individual)
-
-
 def run_flock_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
                         rec: MissionRecording, progress: Progress | None,
                         truth: bool = True) -> MissionReport:
-    """The triangular flock with exact moves; the runner keeps the safety books, reported
-    only with `truth` (the boxes, and where the vehicles really were)."""
+    """The triangular flock with exact moves from its formation slots round the leader's start;
+    the world keeps the safety books, reported only with `truth` (the boxes, and where the
+    vehicles really were), the separation between vehicles always."""
     wall0 = time.monotonic()
     t0 = time.monotonic()
-    scene = flock_scene(spec, mw)
-    prm = FlockRunParams(dt_s=setup.params.step_m / NOMINAL_SPEED_MPS,
-                         proximity=ProximityParams(rings=1, noise_sigma_m=setup.noise_sigma_m))
-    rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
-
-    def factory(sc: FlockScene, ids: list[int]) -> _RecordedFlock:
-        goals = {ids[k]: g for k, g in sc.individual_goals_n.items() if k < len(ids)}
-        inner = FlockPlanner(ids, FlockMission(sc.common_goal_n, goals), sc.heading_n,
-                             setup.params)
-        return _RecordedFlock(inner, rec, t0, prm.dt_s, progress)
-
+    goal = spec.goal_n
+    assert goal is not None
+    ids = [v.sysid for v in spec.vehicles]
+    leader = _at_altitude(start_of(spec, mw, 0), spec.takeoff_alt_m)
+    individual = {ids[k]: g for k, g in enumerate(spec.goals_n[1:]) if k < len(ids)}
     try:
-        res = run_flock(scene, len(spec.vehicles), factory, setup.max_steps,
-                        np.random.default_rng(setup.seed), prm)
+        starts = FlockPlanner(ids, FlockMission(goal, individual),
+                              (goal[0] - leader[0], goal[1] - leader[1]),
+                              setup.params).start_positions_n(leader)
     except ValueError as exc:
         raise UsageError(f"{spec.path}: {exc}") from None
-    lengths = {
-        v: float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))) if len(p) > 1 else 0.0
-        for v, p in res.paths_n.items()
-    }
-    collisions, books = _books(res.collisions, truth)
-    reached = res.status.value == "reached" and collisions == 0
-    reason = res.reason if collisions == 0 else f"{res.reason}; {collisions} collisions"
-    return MissionReport(
-        mission=spec.name, planner=spec.planner.value, mode=RunMode.KINEMATIC,
-        status=MissionStatus.REACHED if reached else MissionStatus.FAILED, reason=reason,
-        collisions=collisions, path_length_m=sum(lengths.values()),
-        duration_s=res.steps * res.dt_s, wall_s=time.monotonic() - wall0, steps=res.steps,
-        recording=rec.path,
-        metrics={
-            **books,
-            "vehicles": res.n_vehicles,
-            "min_separation_m": res.min_separation_m,
-            "min_clearance_m": res.min_clearance_m if truth else None,
-            "messages_sent": res.messages_sent,
-            "state_reads": res.state_reads,
-            "messages_total": res.messages_total,
-            "formation_error_m": res.formation_error_m,
-            "time_to_goal_s": {str(v): res.time_to_goal_s(v) for v in res.steps_to_goal},
-            "path_length_per_vehicle_m": {str(v): x for v, x in lengths.items()},
-            "obstacle_collisions": res.obstacle_collisions if truth else None,
-            "vehicle_collisions": res.vehicle_collisions,
-        },
-    )
+    body = KinematicParams()
+    for v, p in starts.items():
+        if mw.world.clearance(p) < body.body_radius_m:
+            raise UsageError(f"{spec.path}: vehicle {v} would start at {p}, inside an obstacle")
+    rng = np.random.default_rng(setup.seed)  # one noise stream, read in vehicle order
+    prox = ProximityParams(rings=1, noise_sigma_m=setup.noise_sigma_m)
+    sims = {v: KinematicSim(mw.world, starts[v], body, prox, rng) for v in ids}
+    rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
+    port = KinematicPort(spec, rec, sims, t0, step_s=setup.params.step_m / NOMINAL_SPEED_MPS,
+                         progress=progress)
+    outcome = fly_flock(port, setup, starts)
+    obstacle = sum(s.collisions for s in sims.values())
+    collisions, books = _books(obstacle + port.vehicle_collisions, truth)
+    books.update({
+        "min_clearance_m": min(s.min_clearance_m for s in sims.values()) if truth else None,
+        "obstacle_collisions": obstacle if truth else None,
+        "vehicle_collisions": port.vehicle_collisions,
+    })
+    return mission_report(spec, RunMode.KINEMATIC, outcome, collisions=collisions,
+                          books=books, duration_s=port.elapsed_s(),
+                          wall_s=time.monotonic() - wall0, recording=rec.path,
+                          path_length=outcome.metrics["team_path_length_m"])
 
 
 def run_radiation_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,

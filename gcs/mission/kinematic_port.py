@@ -4,6 +4,10 @@ Every set position is reached exactly (`planners.kinematic.KinematicSim` keeps t
 books of each move). Mission time advances by a fixed time per planner move (`step_s`, the
 obstacle planners' nominal step time) or, without one, by the leg's length at `speed_mps`, and
 by each detector count's own time; recordings are stamped on that timeline.
+
+A team's separation is checked on the continuous straight moves between steps (the exact
+closest approach of two linear motions), so `min_separation_m` is the true minimum, and two
+centres closer than the frame's diagonal at the end of a move are a vehicle collision.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from gcs.mission.port import Count
 from gcs.mission.recording import MissionRecording
 from gcs.mission.report import RunMode
 from gcs.mission.spec import MissionSpec
+from planners.flock_sim import FlockRunParams, pairwise_min_m
 from planners.geometry import Vec3
 from planners.kinematic import KinematicSim
 from planners.proximity import ProximityReading
@@ -33,7 +38,8 @@ class KinematicPort:
     def __init__(self, spec: MissionSpec, rec: MissionRecording, sims: dict[int, KinematicSim],
                  t0_s: float, *, step_s: float | None = None, speed_mps: float = 1.0,
                  field: RadiationField | None = None, rng: np.random.Generator | None = None,
-                 progress: Callable[[str], None] | None = None) -> None:
+                 progress: Callable[[str], None] | None = None,
+                 vehicle_collision_m: float = FlockRunParams().vehicle_collision_m) -> None:
         self.spec = spec
         self.rec = rec
         self.sims = sims
@@ -46,6 +52,14 @@ class KinematicPort:
         self._moves = 0  # planner moves of `step_s` each: counted, not summed, to stay exact
         self._progress = progress
         self._events = EventLog(rec, progress)
+        self.vehicle_collision_m = vehicle_collision_m
+        self.vehicle_collisions = 0
+        self._touching: set[tuple[int, int]] = set()
+        self._min_sep_m = pairwise_min_m(self._positions(), self._positions()) \
+            if len(sims) > 1 else math.inf
+
+    def _positions(self) -> np.ndarray:
+        return np.array([s.pos_n for s in self.sims.values()], dtype=float)
 
     def vehicles(self) -> tuple[int, ...]:
         return tuple(self.sims)
@@ -57,6 +71,9 @@ class KinematicPort:
         if self.step_s is None:
             return self._t_s
         return self._t_s + self._moves * self.step_s
+
+    def min_separation_m(self) -> float:
+        return self._min_sep_m
 
     def over_budget(self) -> bool:
         # the thesis's world counts planner steps, not seconds: `max_steps` bounds it
@@ -78,15 +95,26 @@ class KinematicPort:
     def go(self, targets_n: dict[int, Vec3],
            timeout_s: float | None = None) -> dict[int, Vec3]:
         longest = 0.0
+        before = self._positions()
         for v, target in targets_n.items():
             sim = self.sims[v]
             longest = max(longest, math.dist(sim.pos_n, target))
             sim.move_to(target)
+        if len(self.sims) > 1:
+            self._separation(before, self._positions())
         if self.step_s is not None:
             self._moves += 1
         else:
             self._t_s += longest / self.speed_mps
         return {v: self.sims[v].pos_n for v in targets_n}
+
+    def _separation(self, before: np.ndarray, after: np.ndarray) -> None:
+        self._min_sep_m = min(self._min_sep_m, pairwise_min_m(before, after))
+        d_end = np.linalg.norm(after[:, None] - after[None], axis=2)
+        now = {(int(i), int(j)) for i, j in np.argwhere(d_end < self.vehicle_collision_m)
+               if i < j}
+        self.vehicle_collisions += len(now - self._touching)
+        self._touching = now
 
     def check(self) -> dict[int, str]:
         return {}

@@ -1,10 +1,10 @@
 """What a planner's loop needs from the vehicles it flies, whichever world they are in.
 
-A planner loop (`loop_epbha`, `loop_radiation`) is written once against this port; the
-kinematic world (`kinematic_port`, exact moves on a nominal timeline) and MAVLink vehicles
-through their stations (`team_port`) implement it. Mode-specific books (the kinematic world's
-clearances, the SITL's ground truth) stay with the backend and are added to the report after
-the loop.
+A planner loop (`loop_epbha`, `loop_flock`, `loop_radiation`) is written once against this
+port; the kinematic world (`kinematic_port`, exact moves on a nominal timeline) and MAVLink
+vehicles through their stations (`team_port`) implement it. Mode-specific books (the kinematic
+world's clearances, the SITL's ground truth) stay with the backend and are added to the report
+after the loop.
 """
 
 from __future__ import annotations
@@ -47,6 +47,10 @@ class MissionPort(Protocol):
 
     def elapsed_s(self) -> float:
         """Mission time since the loop's vehicles were handed over."""
+        ...
+
+    def min_separation_m(self) -> float:
+        """The smallest distance between two of the vehicles so far (inf for one vehicle)."""
         ...
 
     def over_budget(self) -> bool:

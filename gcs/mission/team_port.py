@@ -32,6 +32,9 @@ class TeamPort:
     def elapsed_s(self) -> float:
         return self.team.elapsed_s()
 
+    def min_separation_m(self) -> float:
+        return self.team.min_separation_m
+
     def over_budget(self) -> bool:
         return self.team.over_budget()
 

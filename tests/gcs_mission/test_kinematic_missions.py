@@ -54,10 +54,10 @@ def test_flock_table_kinematic_brings_all_five_home(
     assert all(t is not None for t in d["time_to_goal_s"].values())
     rec = open_recording(d["recording"])
     steps = [m for _, _, m in rec.messages([topics.STEP_FLOCK])]
-    assert len(steps) == d["steps"]
+    assert len(steps) == d["steps"] + 1  # the last step is the one every vehicle arrived in
     assert set(steps[0]["vehicles"]) == {"1", "2", "3", "4", "5"}
     for v in range(1, 6):  # one pose topic per vehicle
-        assert rec.counts[f"/v{v}/mission/pose"] == d["steps"]
+        assert rec.counts[f"/v{v}/mission/pose"] == d["steps"] + 1
 
 
 def test_radiation_kinematic_encloses_the_three_sources(

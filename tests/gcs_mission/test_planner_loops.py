@@ -10,13 +10,14 @@ from typing import Any
 import numpy as np
 
 from gcs.mission.events import EVENT, MissionEvent
-from gcs.mission.kinematic import start_of
+from gcs.mission.kinematic import run_flock_kinematic, start_of
 from gcs.mission.kinematic_port import KinematicPort
 from gcs.mission.loop_epbha import fly_epbha
+from gcs.mission.loop_flock import fly_flock
 from gcs.mission.loop_radiation import fly_radiation
 from gcs.mission.planner_params import PlannerSetup, planner_setup
 from gcs.mission.port import DetectorPort, ObstaclePort
-from gcs.mission.recording import STEP_EPBHA, MissionRecording
+from gcs.mission.recording import STEP_EPBHA, STEP_FLOCK, MissionRecording
 from gcs.mission.report import MissionStatus
 from gcs.mission.spec import MissionSpec, load_mission
 from gcs.mission.world import MissionWorld, load_world
@@ -58,9 +59,10 @@ class Unsettled(KinematicPort):
 
 
 class LinkLost(KinematicPort):
-    """The vehicle is taken off the mission once it has made `after` moves."""
+    """Vehicle `who` is taken off the mission once the team has made `after` moves."""
 
     after = 3
+    who = 1
     moves = 0
 
     def go(self, targets_n: dict[int, Vec3], timeout_s: float | None = None) -> dict[int, Vec3]:
@@ -68,7 +70,7 @@ class LinkLost(KinematicPort):
         return super().go(targets_n, timeout_s)
 
     def check(self) -> dict[int, str]:
-        return {1: "link lost"} if self.moves >= self.after else {}
+        return {self.who: "link lost"} if self.moves >= self.after else {}
 
 
 class FailsafeLand(KinematicPort):
@@ -136,3 +138,20 @@ def test_a_failsafe_during_a_count_drops_the_sample_and_ends_the_mapping() -> No
     events = tape.topic(EVENT)
     assert [e["event"] for e in events] == [MissionEvent.SAMPLE_DROPPED.value]
     assert out.steps == 2 and len(out.path_n) == 3
+
+
+def test_the_flock_loop_brings_the_team_home_and_stops_for_a_lost_teammate() -> None:
+    spec, mw, setup = _load("flock_table")
+    home = run_flock_kinematic(spec, mw, setup, MissionRecording(None), None)
+    assert home.reached and home.metrics["planner_loop"] == "flock"
+    assert home.duration_s == 0.2 * home.steps
+    ids = [v.sysid for v in spec.vehicles]
+    starts = {v: (float(v), 0.0, -1.0) for v in ids}  # a row 1 m apart, clear of the boxes
+    tape = Tape()
+    port = LinkLost(spec, MissionRecording(tape),
+                    {v: KinematicSim(mw.world, p) for v, p in starts.items()}, 0.0, step_s=0.2)
+    port.who, port.after = 3, 10
+    out = fly_flock(port, setup, starts)
+    assert out.status is MissionStatus.FAILED and out.reason == "vehicle 3: link lost"
+    assert out.steps == 10 and len(tape.topic(STEP_FLOCK)) == 11
+    assert out.metrics["min_separation_m"] <= 1.0
