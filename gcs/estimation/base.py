@@ -87,8 +87,11 @@ class EstimatorParams:
     # integrating the last sample's noise and vibration (±0.6 m/s²) for the whole gap.
     imu_stale_s: float = 0.06
     # The hold's own filter (gcs/estimation/control.py): acceleration noise that puts its
-    # bandwidth on the sonar, well above the altitude loop's crossover
-    control_accel_sigma_mps2: float = 4.0
+    # bandwidth, (q/r)^¼ ≈ 14 rad/s, well above the altitude loop's crossover. 4-8 m/s² held a
+    # little tighter but its velocity, through the D term, doubled the throttle's noise (std
+    # 42-50 us against 23, lockstep apm25 seed 3), and the last override a radio fade leaves
+    # on the vehicle could then lift it 1.4 m before the firmware's failsafe took over.
+    control_accel_sigma_mps2: float = 2.0
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.sonar_min_m < self.sonar_max_m:

@@ -97,15 +97,16 @@ def test_whole_cm_sonar_holds_as_well_as_unrounded(noise_m: float) -> None:
 
 def test_the_hold_flies_on_a_filter_faster_than_its_loop() -> None:
     """The hold's own filter (gcs/estimation/control.py) must have its bandwidth, (q/r)^¼ for
-    accelerometer noise q and sonar noise r, well above the altitude loop's crossover
-    (~4.6 rad/s): at the crossover, the estimate's lag and velocity error lie where the loop
-    amplifies them. One as slow as the loop (0.2 m/s²: 4.4 rad/s) wanders 2.6 times as far.
-    The estimator's own, slower filter (coasting, bias, gates) no longer reaches the hold."""
+    accelerometer noise q and sonar noise r, well above the altitude loop's crossover: at the
+    crossover, the estimate's lag and velocity error lie where the loop
+    amplifies them. One as slow as the loop (0.2 m/s²: 4.4 rad/s) wanders 2.7 times as far.
+    The estimator's own filter (coasting, bias, gates) no longer reaches the hold: made as
+    slow as the loop (0.25 m/s²), the hold is the same."""
     base = StationConfig().estimator
     fast_rms = np.median([fly(base, seed)[0] for seed in range(8)])
     slow_ctl = dataclasses.replace(base, control_accel_sigma_mps2=0.2)
     slow_ctl_rms = np.median([fly(slow_ctl, seed)[0] for seed in range(8)])
     assert slow_ctl_rms > 2.0 * fast_rms, (slow_ctl_rms, fast_rms)
-    slow_main = dataclasses.replace(base, sonar_sigma_m=0.02, accel_sigma_mps2=0.5)
+    slow_main = dataclasses.replace(base, accel_sigma_mps2=0.25)
     slow_main_rms = np.median([fly(slow_main, seed)[0] for seed in range(8)])
-    assert slow_main_rms < 1.2 * fast_rms, (slow_main_rms, fast_rms)
+    assert slow_main_rms < 1.1 * fast_rms, (slow_main_rms, fast_rms)
