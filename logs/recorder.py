@@ -317,16 +317,19 @@ class Recorder:
         """A simulated-time producer's own writing: the whole queue, then a flush when due."""
         queue = self._queue
         while queue:
-            item = queue.popleft()
-            if self._error is None:
-                self._write_item(*item)
-            else:
-                with self._drop_lock:
-                    self._dropped[item[1]] = self._dropped.get(item[1], 0) + 1
+            self._write_or_drop(queue.popleft())
         now = time.monotonic()
         if now >= self._next_flush:
             self._flush()
             self._next_flush = now + self._flush_interval_s
+
+    def _write_or_drop(self, item: Any) -> None:
+        """Write a queued record, or count it dropped once the file has failed."""
+        if self._error is None:
+            self._write_item(*item)
+        else:
+            with self._drop_lock:
+                self._dropped[item[1]] = self._dropped.get(item[1], 0) + 1
 
     def close(self) -> None:
         """Drain the queue, write the summary and index, close the file. Idempotent."""
@@ -366,12 +369,7 @@ class Recorder:
         while True:
             slice_end = time.perf_counter() + YIELD_AFTER_S
             while queue:
-                item = queue.popleft()
-                if self._error is None:
-                    self._write_item(*item)
-                else:
-                    with self._drop_lock:
-                        self._dropped[item[1]] = self._dropped.get(item[1], 0) + 1
+                self._write_or_drop(queue.popleft())
                 if time.perf_counter() > slice_end:
                     # Hand the GIL over: a loop thread waiting for it would otherwise wait for
                     # the interpreter's switch interval (5 ms), a fifth of a control tick.
