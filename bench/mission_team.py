@@ -7,6 +7,9 @@ disarms after 15 s on 3.2.1), the outcome, and the CPU the station and the SITL 
 (in cores: CPU seconds over wall seconds).
 
     .venv/bin/python bench/mission_team.py [--speedup 1] [--seed 3] [--mission FILE]
+
+With `--mission missions/radiation_3src.toml` it also prints the map's samples, IoU (and what
+it was scored against) and the sources enclosed.
 """
 
 from __future__ import annotations
@@ -66,6 +69,9 @@ def main() -> int:
               f"{d.get('min_separation_m')} m")
         print(f"  mission time {d['duration_s']} s, wall {wall:.1f} s; station + SITL CPU "
               f"{cpu:.1f} s = {cpu / wall:.2f} cores")
+        if d.get("samples") is not None:  # a radiation map: how good, against what
+            print(f"  {d['samples']} samples, IoU {d.get('iou')} ({d.get('score_source')}), "
+                  f"sources enclosed {d.get('sources_enclosed')}/{d.get('sources_total')}")
         states = [_first_states(p) for p in d.get("recordings") or [d["recording"]]]
         t0 = min(pre for _, pre in states if pre is not None)
         armed = [s["manual"] for s, _ in states if "manual" in s]
