@@ -88,13 +88,13 @@ class SitlProcess:
 def starved(proc: subprocess.Popen[str], stop_s: float, every_s: float) -> Iterator[None]:
     """Take the CPU away from a process for `stop_s` of every `every_s` wall seconds
     (SIGSTOP, SIGCONT), as a loaded machine does to a SITL. The stall's length is the fault
-    itself: these waits time it, they do not synchronise anything."""
+    itself: the waits on `done` time it, they do not synchronise anything."""
     done = threading.Event()
 
     def stall() -> None:
         while not done.wait(every_s - stop_s):
             os.kill(proc.pid, signal.SIGSTOP)
-            time.sleep(stop_s)
+            done.wait(stop_s)  # the stall's length, cut short when the flight ends
             os.kill(proc.pid, signal.SIGCONT)
 
     worker = threading.Thread(target=stall, name="starve", daemon=True)
