@@ -2,7 +2,7 @@
 a third-order complementary filter (as APM's inertial navigation) and a Kalman filter that also
 fuses the barometer to bridge the sonar's gaps over carpet."""
 
-from gcs.estimation.base import AltEstimate, AltEstimator, EstimatorParams, SonarStatus
+from gcs.estimation.base import AltEstimate, AltEstimator, SonarStatus
 from gcs.estimation.complementary import ComplementaryEstimator
 from gcs.estimation.dead_reckoning import DeadReckoningEstimator
 from gcs.estimation.inputs import (
@@ -12,6 +12,7 @@ from gcs.estimation.inputs import (
     vertical_accel_up_mps2,
 )
 from gcs.estimation.kalman import KalmanEstimator
+from gcs.estimation.params import EstimatorParams
 
 __all__ = [
     "GRAVITY_MPS2",

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import math
 
-from gcs.estimation.base import AltEstimator, EstimatorParams
+from gcs.estimation.base import AltEstimator
+from gcs.estimation.params import EstimatorParams
 
 
 class ComplementaryEstimator(AltEstimator):

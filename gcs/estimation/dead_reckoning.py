@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import math
 
-from gcs.estimation.base import AltEstimator, EstimatorParams
+from gcs.estimation.base import AltEstimator
+from gcs.estimation.params import EstimatorParams
 
 
 class DeadReckoningEstimator(AltEstimator):

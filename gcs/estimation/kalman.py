@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import math
 
-from gcs.estimation.base import AltEstimator, EstimatorParams
+from gcs.estimation.base import AltEstimator
+from gcs.estimation.params import EstimatorParams
 
 _N = 5  # alt_m, vel_mps, bias_mps2, alt_m at the last ping, baro offset_m
 _ALT, _VEL, _CLONE, _BARO = 0, 1, 3, 4
