@@ -217,6 +217,11 @@ class AltEstimator(ABC):
         """Late bursts integrated at their samples' own times."""
         return self._catch_up.replays
 
+    @property
+    def imu_dropped(self) -> int:
+        """IMU samples the link delivered twice (integrated once)."""
+        return self._catch_up.dropped
+
     def snapshot(self) -> object:
         """The filter's state, to be put back by `restore` (its containers copied)."""
         return {k: _copied(v) for k, v in vars(self).items() if k != "_catch_up"}

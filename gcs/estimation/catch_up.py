@@ -14,6 +14,12 @@ own timestamp maps to (`time_usec`, by the offset of samples that arrived prompt
 readings (which carry no timestamp in 3.2.1's RANGEFINDER) spread over the burst's span in
 the order they came. The estimates the controller already used are not changed, only what
 the filter knows from now on.
+
+A sample with the vehicle time of one taken in the kept second is the link delivering a
+frame twice (a retrying radio, two routes to one vehicle): it is dropped and counted, not
+integrated again. One that is merely out of order is placed at its time like any late one.
+A vehicle time ahead of the station's clock by more than the kept second (a frame garbled
+in a way the CRC missed) is integrated as prompt but does not teach the offset.
 """
 
 from __future__ import annotations
@@ -81,6 +87,10 @@ class CatchUp:
     def __init__(self, params: CatchUpParams | None = None) -> None:
         self.params = params or CatchUpParams()
         self.replays = 0  # late samples integrated at their own times
+        self.dropped = 0  # IMU samples the link delivered twice
+        self.implausible = 0  # vehicle times ahead of the station's clock: not learned from
+        self._taken: deque[tuple[float, int]] = deque()  # (tick, vehicle time) in the window
+        self._taken_usec: set[int] = set()
         self._kept: deque[_Kept] = deque()
         self._offsets: deque[tuple[float, float]] = deque()  # (tick, rx time - vehicle time)
 
@@ -89,6 +99,7 @@ class CatchUp:
         """Run `step` on this tick's inputs, or on the kept ticks again from the earliest one
         that the late samples were due at; returns the last step's result."""
         p = self.params
+        inputs = self._without_repeats(inputs)
         while self._kept and self._kept[0].inputs.t_s < inputs.t_s - p.max_window_s:
             self._kept.popleft()
         offset = self._offset_s()
@@ -110,13 +121,28 @@ class CatchUp:
         self._learn_offset(inputs)
         return result
 
+    def _without_repeats(self, inputs: TickInputs) -> TickInputs:
+        """The tick's inputs without the IMU samples already taken."""
+        while self._taken and self._taken[0][0] < inputs.t_s - self.params.max_window_s:
+            self._taken_usec.discard(self._taken.popleft()[1])
+        kept: list[Imu] = []
+        for imu in inputs.imus:
+            if imu.time_usec > 0 and imu.time_usec in self._taken_usec:
+                self.dropped += 1
+                continue
+            if imu.time_usec > 0:
+                self._taken.append((inputs.t_s, imu.time_usec))
+                self._taken_usec.add(imu.time_usec)
+            kept.append(imu)
+        return inputs if len(kept) == len(inputs.imus) else replace(inputs, imus=tuple(kept))
+
     def _replay_from(self, inputs: TickInputs, offset_s: float | None) -> int | None:
         """Index of the kept tick to run again from, None when this tick's samples are on time."""
         if offset_s is None or not inputs.imus or not self._kept:
             return None
         if any(i.time_usec <= 0 for i in inputs.imus):
             return None  # samples without the vehicle's time: nothing to place them by
-        due = inputs.imus[0].time_usec * USEC + offset_s
+        due = min(i.time_usec for i in inputs.imus) * USEC + offset_s  # reordered: the earliest
         if due >= self._kept[-1].inputs.t_s - self.params.late_s:
             return None
         if due < self._kept[0].inputs.t_s:
@@ -130,7 +156,12 @@ class CatchUp:
         if not inputs.imus or inputs.imus[-1].time_usec <= 0:
             return
         last = inputs.imus[-1]
-        self._offsets.append((inputs.t_s, last.t_s - last.time_usec * USEC))
+        offset = last.t_s - last.time_usec * USEC
+        least = self._offset_s()
+        if least is not None and offset < least - self.params.max_window_s:
+            self.implausible += 1
+            return
+        self._offsets.append((inputs.t_s, offset))
         while self._offsets[0][0] < inputs.t_s - self.params.offset_window_s:
             self._offsets.popleft()
 

@@ -135,3 +135,72 @@ def test_a_replay_keeps_what_the_silence_ticks_brought() -> None:
     r = est.update_tick(burst, [], att, t0 + 8 * DT)
     assert est.burst_replays == 1
     assert r.alt_m == pytest.approx(1.02, abs=0.01)
+
+
+def _imu(t_rx: float, t_vehicle: float, f: tuple[float, float, float]) -> Imu:
+    return Imu(t_rx, 1, f, (0, 0, 0), "RAW_IMU", round(t_vehicle * 1e6))
+
+
+def test_the_link_dying_mid_burst_leaves_a_coasting_filter_that_recovers() -> None:
+    """0.3 s of silence, half of what was missed, then nothing for 3 s: the half is placed
+    at its times, the rest of the outage is coasted with no acceleration, and when the link
+    is back its samples are prompt again (no replay across the outage)."""
+    est, att, rest = _hovered()
+    t0 = 199 * DT
+    silent = [t0 + j * DT for j in range(1, 13)]  # the SITL is stopped
+    for t in silent[:-1]:
+        est.update_tick([], [], att, t)
+    half = [_imu(silent[-1], t, rest) for t in silent[:6]]
+    est.update_tick(half, [], att, silent[-1])
+    assert est.burst_replays == 1
+    t, coasting = silent[-1], []
+    while t < silent[-1] + 3.0:  # the link dies
+        t += DT
+        r = est.update_tick([], [], att, t)
+        coasting.append(r.coasting)
+        assert math.isfinite(r.alt_m) and abs(r.alt_m - 1.0) < 0.1
+    assert all(coasting[int(0.3 / DT):])
+    for k in range(80):  # back: prompt samples, the sonar at 1.0 m
+        t += DT
+        sonar = [Rangefinder(t, 1, 1.0, True, "RANGEFINDER")] if k % 2 else []
+        r = est.update_tick([_imu(t, t, rest)], sonar, att, t)
+    assert est.burst_replays == 1
+    assert not r.coasting
+    assert abs(r.alt_m - 1.0) < 0.02
+
+
+def test_a_frame_delivered_twice_is_integrated_once_and_counted() -> None:
+    """A retrying radio (or two routes to one vehicle) repeats a sample 0.2 s later: taken
+    again, its acceleration would count twice and the replay would re-run the filter."""
+    once, att, rest = _hovered()
+    twice, _, _ = _hovered()
+    t0 = 199 * DT
+    lift = body_specific_force(1.5, 0.0, 0.0)
+    for j in range(1, 20):
+        t = t0 + j * DT
+        f = lift if j == 3 else rest
+        a = once.update_tick([_imu(t, t, f)], [], att, t)
+        repeat = [_imu(t, t0 + 3 * DT, lift)] if j == 11 else []
+        b = twice.update_tick([*repeat, _imu(t, t, f)], [], att, t)
+        assert (a.alt_m, a.vel_mps) == (b.alt_m, b.vel_mps)
+    assert twice.imu_dropped == 1 and once.imu_dropped == 0
+    assert twice.burst_replays == 0
+
+
+def test_a_garbled_vehicle_time_neither_replays_nor_stops_the_catching_up() -> None:
+    """A frame whose time_usec was garbled and still passed the CRC: far ahead, it must not
+    become the vehicle-to-station offset (every later sample would look a second late);
+    far behind, it is older than anything kept. Each is integrated as it comes."""
+    est, att, rest = _hovered()
+    t = 199 * DT
+    for garbled in (t + 5000.0, 1e-6):
+        t += DT
+        r = est.update_tick([_imu(t, garbled, rest)], [], att, t)
+        assert math.isfinite(r.alt_m) and abs(r.alt_m - 1.0) < 0.05
+    assert est.burst_replays == 0
+    for _ in range(6):  # and a real burst after them is still caught up
+        t += DT
+        est.update_tick([], [], att, t)
+    t += DT
+    est.update_tick([_imu(t, t - j * DT, rest) for j in range(6, -1, -1)], [], att, t)
+    assert est.burst_replays == 1
