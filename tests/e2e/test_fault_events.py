@@ -79,10 +79,11 @@ Trigger = Callable[[subprocess.Popen[str], FaultProxy, MavWatcher], None]
 
 
 @contextlib.contextmanager
-def _rig(profile: str) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy, StationTap]]:
+def _rig(profile: str, speedup: float,
+         ) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy, StationTap]]:
     udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     udp.bind(("127.0.0.1", 0))
-    args = ["--tcp", "0", "--profile", profile, "--speedup", f"{SPEEDUP:g}", "--seed", "4",
+    args = ["--tcp", "0", "--profile", profile, "--speedup", f"{speedup:g}", "--seed", "4",
             "--udp", f"127.0.0.1:{udp.getsockname()[1]}"]
     with contextlib.ExitStack() as stack:
         sitl = stack.enter_context(_sitl(args))
@@ -94,20 +95,20 @@ def _rig(profile: str) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy
         stack.callback(watch_mocap.close)
         tap = StationTap()
         h, p = sitl.endpoint(1, "tcp").rsplit(":", 1)
-        proxy = FaultProxy(target=(h, int(p)), seed=4, time_scale=SPEEDUP, tap=tap).start()
+        proxy = FaultProxy(target=(h, int(p)), seed=4, time_scale=speedup, tap=tap).start()
         stack.callback(proxy.stop)
         sitl.mocap_url = mocap_url
         yield sitl, watch_udp, watch_mocap, proxy, tap
 
 
 def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float = 3.0,
-        extra: tuple[str, ...] = (), watch_s: float = 25.0) -> Run:
+        extra: tuple[str, ...] = (), watch_s: float = 25.0, speedup: float = SPEEDUP) -> Run:
     """Fly 1 m; `after_s` simulated seconds into `phase` (seen on --live) call `trigger`; keep
     watching for `watch_s` simulated seconds after it."""
-    with _rig(profile) as (sitl, watch_udp, watch_mocap, proxy, tap):
+    with _rig(profile, speedup) as (sitl, watch_udp, watch_mocap, proxy, tap):
         argv = [sys.executable, "-m", "gcs", "fly", "--connect", proxy.address, "--mocap",
                 sitl.mocap_url, "--profile", profile, "--alt", f"{SETPOINT_M}", "--hold", "20",
-                "--json", "--live", "--no-record", "--speedup", f"{SPEEDUP:g}", "--fix-failsafe",
+                "--json", "--live", "--no-record", "--speedup", f"{speedup:g}", "--fix-failsafe",
                 *extra]
         proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                 cwd=ROOT, env=dict(os.environ, PYTHONUNBUFFERED="1"))
@@ -131,7 +132,7 @@ def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float =
             r.start()
         fired.wait(200.0)
         # keep watching `watch_s` simulated seconds after the trigger (or after fly ended)
-        watch_mocap.wait_sim(watch_s, timeout_s=watch_s / SPEEDUP + 30.0)
+        watch_mocap.wait_sim(watch_s, timeout_s=watch_s / speedup + 30.0)
         try:
             code = proc.wait(timeout=60.0)
         except subprocess.TimeoutExpired:
@@ -195,8 +196,12 @@ def _kill_in_fault(direction: Direction, fault_s: float) -> Trigger:
                          ids=lambda d: d.value)
 def test_kill_during_a_link_loss_cuts_the_throttle_and_disarms_once_heard(
         direction: Direction) -> None:
+    """At 2x, not 4x: 4.x's GCS failsafe fires after 2 simulated seconds without the
+    station's overrides, and on a loaded fresh-clone CI run at 4x a half-second stall of the
+    station (no fault yet) once let it put the vehicle in LAND before the kill: the station
+    then rightly reported that, and this test's premise was gone."""
     fault_s = 6.0
-    r = fly("copter4", _kill_in_fault(direction, fault_s), watch_s=20.0)
+    r = fly("copter4", _kill_in_fault(direction, fault_s), watch_s=20.0, speedup=2.0)
     assert r.event_s is not None
     kill_s = r.event_s + 1.5
     assert r.exit_code == 3 and "KILL" in r.reason, r.reason
