@@ -201,20 +201,24 @@ def _server_from_args(args: argparse.Namespace) -> SitlServer:
         options = AutopilotOptions(
             realistic_boot=opts.realistic_boot or args.realistic_boot,
             copter4_version=args.copter4_version or opts.copter4_version,
+            params=opts.params,
         )
     except ValueError as exc:
         raise CliError(str(exc), 2) from None
     if args.copter4_version and profile is not Profile.COPTER4:
         raise CliError("--copter4-version: needs --profile copter4", 2)
-    sim = Simulation(
-        world,
-        profile,
-        args.vehicles,
-        seed=args.seed,
-        noise=not args.no_noise,
-        signing_key=key,
-        options=options,
-    )
+    try:
+        sim = Simulation(
+            world,
+            profile,
+            args.vehicles,
+            seed=args.seed,
+            noise=not args.no_noise,
+            signing_key=key,
+            options=options,
+        )
+    except WorldError as exc:
+        raise CliError(f"{args.world or 'world'}: {exc}", 2) from None
     mocap_port = None
     if world.mocap_enabled:
         if args.mocap_port is not None:

@@ -25,7 +25,7 @@ from sitl.link.handler import VehicleLink
 from sitl.link.view import GeoOrigin, VehicleView
 from sitl.sensors import MocapSample
 from sitl.vehicle_model import SimVehicle
-from sitl.world import World
+from sitl.world import World, WorldError
 
 LOOP_RATE_HZ = 100.0
 BARO_RATE_HZ = 10.0
@@ -66,6 +66,11 @@ class VehicleRuntime:
         self.params.set_key(Key.RNG_MIN_M, sonar.min_m)
         self.params.set_key(Key.RNG_MAX_M, sonar.max_m)
         self.autopilot = Autopilot(profile, self.params, self.vehicle.hover_throttle(), options)
+        for name, value in options.params:  # the owner's values win over the set-up above
+            try:
+                self.params.set(name, value)
+            except ValueError as exc:
+                raise WorldError(f"autopilot.params.{name}: {exc} in {profile.value}") from None
         self.view = VehicleView(
             sysid=sysid,
             profile=profile,

@@ -17,6 +17,7 @@ on the floor, because heights are what people measure; the loader converts them 
     [vehicle]    overrides of sitl.params.VehicleParams
     [autopilot]  realistic_boot = true      # copter4: the real ≈ 24 s pre-arm delay
                  copter4_version = "4.6"    # parameter names of a 4.x before 4.7
+    [autopilot.params]  FS_BATT_ENABLE = 1   # values the vehicle boots with (the profile's names)
 
 A bad file raises WorldError with one line: `<file>: <field>: <problem>`.
 """
@@ -346,13 +347,23 @@ def world_from_toml(data: Mapping[str, Any]) -> World:
 
 
 def _parse_autopilot(data: Any) -> AutopilotOptions:
-    data = _table(data, "autopilot", {"realistic_boot", "copter4_version"})
+    data = _table(data, "autopilot", {"realistic_boot", "copter4_version", "params"})
     realistic = data.get("realistic_boot", False)
     if not isinstance(realistic, bool):
         raise ParamError(f"autopilot.realistic_boot: expected true or false, got {realistic!r}")
     version = data.get("copter4_version", "4.7")
+    values = data.get("params", {})
+    if not isinstance(values, Mapping):
+        raise ParamError(f"autopilot.params: expected a table, got {type(values).__name__}")
+    params: list[tuple[str, float]] = []
+    for name, value in values.items():
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(
+                value):
+            raise ParamError(f"autopilot.params.{name}: expected a finite number, got {value!r}")
+        params.append((str(name), float(value)))
     try:
-        return AutopilotOptions(realistic_boot=realistic, copter4_version=str(version))
+        return AutopilotOptions(realistic_boot=realistic, copter4_version=str(version),
+                                params=tuple(params))
     except ValueError as exc:
         raise ParamError(f"autopilot.{exc}") from None
 

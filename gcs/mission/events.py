@@ -23,7 +23,7 @@ class MissionEvent(enum.Enum):
     DISARMED_ON_FLOOR = "disarmed_on_floor"  # the team took too long: disarmed before take-off
     TAKING_OFF = "taking_off"
     AIRBORNE = "airborne"  # every vehicle at its hover point: the planner starts
-    SAMPLE_DROPPED = "sample_dropped"  # a reading taken off mission (the autopilot took over)
+    SAMPLE_DROPPED = "sample_dropped"  # a count not taken as a sample: off mission or off height
     OFF_MISSION = "off_mission"  # the link or the autopilot took a vehicle: the mission stops
     LEFT_TO_ITSELF = "left_to_itself"  # not landed by the station: its LAND or failsafe does
     LANDING = "landing"

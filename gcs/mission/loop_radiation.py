@@ -3,7 +3,10 @@
 The mapper is given where the vehicle was while the detector counted (on a vehicle the mean
 mocap position, in the kinematic world the sample point itself), and the mission stops when the
 vehicle is taken off it (a battery failsafe's LAND, say): a reading from then on is not the
-mission's.
+mission's. Nor is one counted away from the mapping height: the field falls off with the
+distance to its sources, and a vehicle sinking on a sagging battery before its failsafe acts
+(17 cm low at 1 m, lockstep, two 300 mAh packs) would put a reading of another height on the
+map. Such a count is dropped and taken again where the vehicle is, a few times in a row at most.
 """
 
 from __future__ import annotations
@@ -25,6 +28,8 @@ from planners.radiation_field import RadiationField
 
 LOOP = "radiation"
 TRAVEL_MPS = 0.5  # radiation legs: the timeout grows with the leg at this speed
+HEIGHT_TOL_M = 0.15  # a count further than this from the mapping height is not a sample
+OFF_HEIGHT_MAX = 5  # counts in a row off the height: the vehicle cannot hold it, stop
 
 
 def count_time_s(cps: float, p: RadiationMapperParams) -> float:
@@ -49,7 +54,7 @@ def fly_radiation(port: DetectorPort, setup: PlannerSetup, start_n: Vec3,
     target: Vec3 = (float(here[0]), float(here[1]), -alt)
     port.go({v: target}, timeout_s=spec.step_timeout_s + math.dist(start_n, target) / TRAVEL_MPS)
     path: list[Vec3] = [target]
-    k = 0
+    k = off_height = 0
     stopped: str | None = None
     while True:
         c = port.count(v, p)
@@ -58,6 +63,16 @@ def fly_radiation(port: DetectorPort, setup: PlannerSetup, start_n: Vec3,
             port.event(MissionEvent.SAMPLE_DROPPED, v, f"sample {k}: {stopped}")
             break
         m, cps = c.at_n, c.counts_per_s
+        off_m = -m[2] - alt
+        if abs(off_m) > HEIGHT_TOL_M:
+            off_height += 1
+            port.event(MissionEvent.SAMPLE_DROPPED, v,
+                       f"sample {k}: counted {off_m:+.2f} m off the {alt:g} m height")
+            if off_height >= OFF_HEIGHT_MAX:
+                stopped = f"{off_height} counts in a row off the {alt:g} m height"
+                break
+            continue
+        off_height = 0
         decision = mapper.step((m[0], m[1]), cps, c.counted_s)
         t = port.now_s()
         port.rec.put(SAMPLE_RADIATION, t,

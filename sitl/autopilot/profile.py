@@ -55,10 +55,13 @@ class AutopilotOptions:
     after boot instead of the short default. `copter4_version` "4.6": the parameter names of a
     4.x before 4.7 (SYSID_MYGCS, SYSID_THISMAV, SRn_*) instead of 4.7's (MAV_GCS_SYSID,
     MAV_SYSID, MAVn_*).
+    `params`: parameter values the vehicle boots with, as a real SITL's defaults file sets
+    them (a battery failsafe the owner turned on, say); names are the profile's own.
     """
 
     realistic_boot: bool = False
     copter4_version: str = "4.7"
+    params: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         if self.copter4_version not in COPTER4_VERSIONS:

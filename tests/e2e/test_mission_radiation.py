@@ -16,7 +16,6 @@ from gcs.mission.planner_params import planner_setup
 from gcs.mission.spec import load_mission
 from gcs.mission.world import load_world
 from logs import open_recording
-from tests.e2e.sitl_proc import SitlProcess
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -56,48 +55,32 @@ def test_a_short_mapping_flight_samples_the_sitl_field(tmp_path: Path) -> None:
 
 
 @pytest.mark.e2e
-@pytest.mark.solo  # a wall-clock flight at 2x: bursts of a starved SITL would blur its samples
 @pytest.mark.timeout(240)
-@pytest.mark.xfail(strict=False, reason=(
-    "since samples are counted on the move, runs differ: on a fresh-clone CI run the one-pack "
-    "world's 450 mAh emptied before a LAND was seen (disarmed 92 s in), and with two 300 mAh "
-    "packs one run kept a sample outside 0.85-1.15 m (open)"))
 def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
         tmp_path: Path) -> None:
-    # A small pack: the autopilot's battery failsafe switches to LAND within a minute of flight
-    # (with 300-450 mAh on this airframe's single pack the vehicle ran empty and disarmed
-    # 66-92 s in, before the mission reported a LAND).
-    # The mission must stop there and say why, not take floor readings as mapped ones. Both
-    # firmwares ship with the battery failsafe off; the pilot turns it on, as on a real vehicle.
+    """Two small packs in parallel (300 mAh each; on one pack's resistance the sag emptied it
+    and the vehicle disarmed before a LAND was seen): the autopilot's battery failsafe,
+    which the owner turned on (both firmwares ship it off), switches to LAND about a minute
+    in. The mission must stop there and say why, not take floor readings as mapped ones.
+
+    In lockstep, so the flight is its seed's: flown at 2x over TCP, the samples counted on the
+    move made runs differ, and one in two kept a sample outside 0.85-1.15 m or ran the pack
+    empty before the LAND was seen."""
     world_text, n = re.subn(
         r"(?m)^battery_capacity_mah = .*$",
-        # two small packs in parallel (half the resistance, 0.25 kg more): on one pack's
-        # resistance the sag emptied it and the vehicle disarmed before the LAND was seen
         "battery_capacity_mah = 300.0\nbattery_resistance_ohm = 0.0225\nmass_kg = 1.88",
         (ROOT / "worlds" / "radiation_3src.toml").read_text())
     assert n == 1
     world = tmp_path / "small_pack.toml"
-    world.write_text(world_text)
+    world.write_text(world_text + "\n[autopilot.params]\nFS_BATT_ENABLE = 1\n")
     text = (ROOT / "missions" / "radiation_3src.toml").read_text()
     text = re.sub(r'(?m)^world = .*$', f'world = "{world}"', text)
     mission = tmp_path / "small_pack_mission.toml"
     mission.write_text(text)
-    sitl = SitlProcess(["--tcp", "0", "--world", str(world), "--speedup", "2", "--seed", "5",
-                        "--mocap-port", "0"], ROOT)
-    try:
-        url = "tcp:" + sitl.endpoint(1, "tcp")
-        mocap = next(line.split()[1] for line in sitl.lines if line.startswith("mocap "))
-        on = subprocess.run([sys.executable, "-m", "gcs", "params", "--connect", url, "set",
-                             "FS_BATT_ENABLE", "1"], capture_output=True, text=True,
-                            timeout=120, check=False, cwd=ROOT)
-        assert on.returncode == 0, on.stderr
-        proc = subprocess.run(
-            [sys.executable, "-m", "gcs", "mission", "run", str(mission), "--connect", url,
-             "--mocap", mocap, "--speedup", "2", "--json",
-             "-o", str(tmp_path), "--plot", str(tmp_path / "p.png")],
-            capture_output=True, text=True, timeout=200, check=False, cwd=ROOT)
-    finally:
-        sitl.stop()
+    proc = subprocess.run(
+        [sys.executable, "-m", "gcs", "mission", "run", str(mission), "--lockstep", "--seed", "5",
+         "--json", "-o", str(tmp_path), "--plot", str(tmp_path / "p.png")],
+        capture_output=True, text=True, timeout=200, check=False, cwd=ROOT)
     out = proc.stdout.strip().splitlines()
     assert out, f"exit {proc.returncode}: {proc.stderr.strip()}"
     d = json.loads(out[-1])

@@ -352,3 +352,29 @@ def test_command_line_options_reach_the_autopilot(capsys: pytest.CaptureFixture[
         server.close()
     assert cli.main(["--tcp", "0", "--copter4-version", "4.6"]) == 2  # apm25 has no such thing
     assert "--copter4-version: needs --profile copter4" in capsys.readouterr().err
+
+
+def test_world_file_boot_parameters_reach_the_vehicle_and_bad_ones_say_which(
+        tmp_path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`[autopilot.params]`: what a real SITL's defaults file does, e.g. the battery failsafe
+    the owner turned on (both firmwares ship it off), set before any station connects."""
+    from sitl import cli
+
+    room = '[room]\nmin = [-3, -3, 0]\nmax = [3, 3, 3]\n'
+    path = tmp_path / "w.toml"
+    path.write_text(room + '[autopilot.params]\nFS_BATT_ENABLE = 1\n')
+    world = load_world(path)
+    assert world.autopilot.params == (("FS_BATT_ENABLE", 1.0),)
+    assert Simulation(world, Profile.APM25, 1).vehicle(1).params.get("FS_BATT_ENABLE") == 1.0
+    path.write_text(room + '[autopilot.params]\nDISARM_DELAY = 4\n')
+    world = load_world(path)
+    assert Simulation(world, Profile.COPTER4, 1).vehicle(1).params.get("DISARM_DELAY") == 4.0
+    # names are the profile's own: 3.2.1 has no DISARM_DELAY
+    with pytest.raises(WorldError, match=r"autopilot\.params\.DISARM_DELAY: .* in apm25"):
+        Simulation(world, Profile.APM25, 1)
+    assert cli.main(["--tcp", "0", "--world", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "DISARM_DELAY" in err and "apm25" in err
+    path.write_text(room + '[autopilot.params]\nFS_BATT_ENABLE = "on"\n')
+    with pytest.raises(WorldError, match=r"autopilot\.params\.FS_BATT_ENABLE: expected a finite"):
+        load_world(path)
