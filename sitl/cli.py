@@ -10,12 +10,13 @@ Expected errors end in one line on stderr: exit 2 for bad input, 1 for run-time 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import signal
 import sys
 from collections.abc import Sequence
 from types import FrameType
 
-from sitl.autopilot import AutopilotOptions, Profile
+from sitl.autopilot import Profile
 from sitl.autopilot.profile import COPTER4_VERSIONS
 from sitl.link.codec import SigningKeyError, load_signing_key
 from sitl.link.endpoints import EndpointError
@@ -198,10 +199,10 @@ def _server_from_args(args: argparse.Namespace) -> SitlServer:
             raise CliError(str(exc), 2) from None
     opts = world.autopilot
     try:
-        options = AutopilotOptions(
+        options = dataclasses.replace(  # the world's options, the command line's on top
+            opts,
             realistic_boot=opts.realistic_boot or args.realistic_boot,
             copter4_version=args.copter4_version or opts.copter4_version,
-            params=opts.params,
         )
     except ValueError as exc:
         raise CliError(str(exc), 2) from None

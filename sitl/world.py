@@ -186,12 +186,13 @@ def _numbers(value: Any, n: int, where: str) -> tuple[float, ...]:
         raise ParamError(f"{where}: expected {n} numbers, got {type(value).__name__}")
     if len(value) != n:
         raise ParamError(f"{where}: expected {n} numbers, got {len(value)}")
-    out = []
-    for i, v in enumerate(value):
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-            raise ParamError(f"{where}[{i}]: expected a finite number, got {v!r}")
-        out.append(float(v))
-    return tuple(out)
+    return tuple(_number(v, f"{where}[{i}]") for i, v in enumerate(value))
+
+
+def _number(value: Any, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ParamError(f"{where}: expected a finite number, got {value!r}")
+    return float(value)
 
 
 def _name(data: Mapping[str, Any], where: str) -> str:
@@ -355,12 +356,7 @@ def _parse_autopilot(data: Any) -> AutopilotOptions:
     values = data.get("params", {})
     if not isinstance(values, Mapping):
         raise ParamError(f"autopilot.params: expected a table, got {type(values).__name__}")
-    params: list[tuple[str, float]] = []
-    for name, value in values.items():
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(
-                value):
-            raise ParamError(f"autopilot.params.{name}: expected a finite number, got {value!r}")
-        params.append((str(name), float(value)))
+    params = [(str(k), _number(v, f"autopilot.params.{k}")) for k, v in values.items()]
     try:
         return AutopilotOptions(realistic_boot=realistic, copter4_version=str(version),
                                 params=tuple(params))

@@ -89,8 +89,7 @@ class CatchUp:
         self.replays = 0  # late samples integrated at their own times
         self.dropped = 0  # IMU samples the link delivered twice
         self.implausible = 0  # vehicle times ahead of the station's clock: not learned from
-        self._taken: deque[tuple[float, int]] = deque()  # (tick, vehicle time) in the window
-        self._taken_usec: set[int] = set()
+        self._taken: dict[int, float] = {}  # vehicle time -> tick, oldest first, in the window
         self._kept: deque[_Kept] = deque()
         self._offsets: deque[tuple[float, float]] = deque()  # (tick, rx time - vehicle time)
 
@@ -123,16 +122,19 @@ class CatchUp:
 
     def _without_repeats(self, inputs: TickInputs) -> TickInputs:
         """The tick's inputs without the IMU samples already taken."""
-        while self._taken and self._taken[0][0] < inputs.t_s - self.params.max_window_s:
-            self._taken_usec.discard(self._taken.popleft()[1])
+        taken, cutoff = self._taken, inputs.t_s - self.params.max_window_s
+        while taken:
+            oldest = next(iter(taken))
+            if taken[oldest] >= cutoff:
+                break
+            del taken[oldest]
         kept: list[Imu] = []
         for imu in inputs.imus:
-            if imu.time_usec > 0 and imu.time_usec in self._taken_usec:
-                self.dropped += 1
-                continue
             if imu.time_usec > 0:
-                self._taken.append((inputs.t_s, imu.time_usec))
-                self._taken_usec.add(imu.time_usec)
+                if imu.time_usec in taken:
+                    self.dropped += 1
+                    continue
+                taken[imu.time_usec] = inputs.t_s
             kept.append(imu)
         return inputs if len(kept) == len(inputs.imus) else replace(inputs, imus=tuple(kept))
 
