@@ -214,6 +214,7 @@ def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunO
     alts: dict[int, AltControlOutput] = {}
     latest_att: Attitude | None = None
     latest_pose: MocapPose | None = None
+    cmd_acc: float | None = None  # what the previous tick's command asked of the vehicle
     for frame in flight.ticks:
         t = frame.inputs
         if frame.attitudes:
@@ -224,16 +225,16 @@ def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunO
         sonars = frame.sonars
         baro = baro_altitude_m(frame.baros[-1].pressure_pa) if frame.baros else None
         est = estimator.update_tick(list(frame.imus), sonars, attitude, t.t_s,
-                                    at_rest=t.at_rest, baro_alt_m=baro)
+                                    at_rest=t.at_rest, baro_alt_m=baro, command_acc_mps2=cmd_acc)
         estimates[frame.log_ns] = est
-        sup.step(TickIn(
+        cmd_acc = sup.step(TickIn(
             t_s=t.t_s, dt_s=t.dt_s, intents=frame.intents,
             vehicle=VehicleStatus(seen=t.vehicle_seen, armed=t.armed, mode=t.vehicle_mode,
                                   heartbeat_t_s=t.heartbeat_t_s, frame_age_s=t.frame_age_s),
             estimate=est,
             roll_rad=latest_att.roll_rad if latest_att is not None else 0.0,
             pitch_rad=latest_att.pitch_rad if latest_att is not None else 0.0,
-            mocap=latest_pose))
+            mocap=latest_pose)).command_acc_mps2
         if sup.alt is not None:  # the station records the last output on held ticks too
             alts[frame.log_ns] = sup.alt
     return RerunOutputs(estimates, alts)

@@ -349,7 +349,8 @@ class Station(StationIntents):
                    and status.frame_age_s <= self.supervisor_params.lost_after_s)
         est = self.estimator.update_tick(
             imus, sonars, attitude, t_s, at_rest=at_rest,
-            baro_alt_m=None if baro is None else baro_altitude_m(baro.pressure_pa))
+            baro_alt_m=None if baro is None else baro_altitude_m(baro.pressure_pa),
+            command_acc_mps2=self._out.command_acc_mps2 if self._out is not None else None)
         self._estimate = est
         att = self._latest.get(Attitude)
         pose = self._latest.get(MocapPose)

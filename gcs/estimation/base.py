@@ -91,6 +91,9 @@ class AltEstimator(ABC):
         self._reject_seen_s = -math.inf  # last rejected reading, or a repeat of it
         self._catch_up = CatchUp()
         self._control = control_start(0.0, 0.0, 0.1**2)
+        self._command_acc: float | None = None
+        self._command_lagged = 0.0
+        self._command_residual = 0.0
 
     @abstractmethod
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
@@ -139,7 +142,8 @@ class AltEstimator(ABC):
             a = self._acc_up - self._state()[2]
             self._repeat_move_m += (self._repeat_vel_mps + 0.5 * a * dt) * dt
             self._repeat_vel_mps += a * dt
-            control_predict(self._control, a, dt, p.control_accel_sigma_mps2)
+            control_predict(self._control, self._control_accel(a, dt), dt,
+                            p.control_accel_sigma_mps2)
         alt_before = self._state()[0]
         self._history.append((t_s, alt_before))
         while self._history[0][0] < t_s - p.history_s:
@@ -196,6 +200,18 @@ class AltEstimator(ABC):
             control_vel_mps=ctl[1],
         )
 
+    def _control_accel(self, measured: float, dt: float) -> float:
+        p = self.params
+        cmd = self._command_acc
+        if cmd is None or p.command_blend_tc_s <= 0.0:
+            self._command_lagged, self._command_residual = measured, 0.0
+            return measured
+        self._command_lagged += (cmd - self._command_lagged) * dt / (p.command_lag_s + dt)
+        resid = measured - self._command_lagged
+        self._command_residual += (resid - self._command_residual) * dt / (
+            p.command_blend_tc_s + dt)
+        return self._command_lagged + self._command_residual
+
     def update_tick(
         self,
         imus: Sequence[Imu] | Imu | None,
@@ -204,10 +220,15 @@ class AltEstimator(ABC):
         t_s: float,
         at_rest: bool = False,
         baro_alt_m: float | None = None,
+        command_acc_mps2: float | None = None,
     ) -> AltEstimate:
-        """One control tick with every sample it brought (see `catch_up` for late bursts)."""
+        """One control tick with every sample it brought (see `catch_up` for late bursts).
+
+        `command_acc_mps2`: the vertical acceleration the last stick command sent asks of the
+        vehicle (None when the station does not fly the throttle)."""
         samples = () if imus is None else (imus,) if isinstance(imus, Imu) else tuple(imus)
-        inputs = TickInputs(t_s, samples, tuple(sonars), attitude, at_rest, baro_alt_m)
+        inputs = TickInputs(t_s, samples, tuple(sonars), attitude, at_rest, baro_alt_m,
+                            command_acc_mps2)
         est = self._catch_up.tick(self, inputs, self._run_tick)
         assert isinstance(est, AltEstimate)
         return est
@@ -240,6 +261,7 @@ class AltEstimator(ABC):
         table's height as an error and dives for the surface it just left.
         """
         sonars = tick.sonars
+        self._command_acc = tick.command_acc_mps2
         est = self.update(average_imu(tick.imus), sonars[0] if sonars else None, tick.attitude,
                           tick.t_s, at_rest=tick.at_rest, baro_alt_m=tick.baro_alt_m)
         rebased = est.sonar_status is SonarStatus.REACQUIRED

@@ -57,6 +57,8 @@ class TickInputs:
     attitude: Attitude | None
     at_rest: bool
     baro_alt_m: float | None
+    # the vertical acceleration the station's last stick command asked for (None: not known)
+    command_acc_mps2: float | None = None
 
 
 class Restorable(Protocol):

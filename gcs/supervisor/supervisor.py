@@ -164,7 +164,9 @@ class Supervisor:
             actions=tuple(self._actions), notes=tuple(self._notes),
             transitions=tuple(self._transitions),
             alt_setpoint_m=self.alt_setpoint_m if self.state in PC_CONTROL else None,
-            throttle_gate_us=self.gate_us if self.state is S.MANUAL else None)
+            throttle_gate_us=self.gate_us if self.state is S.MANUAL else None,
+            command_acc_mps2=None if command is None or self.state is not S.HOLD else
+            self.alt_ctrl.accel_for_throttle(command.throttle_us, inp.roll_rad, inp.pitch_rad))
 
     def _health(self, inp: TickIn) -> LinkHealth:
         age = inp.vehicle.frame_age_s

@@ -169,3 +169,6 @@ class SupervisorOutput:
     transitions: tuple[Transition, ...]
     alt_setpoint_m: float | None
     throttle_gate_us: int | None  # MANUAL: the throttle held until the pilot's stick meets it
+    # HOLD: the vertical acceleration the command's throttle asks of the vehicle (the hold's
+    # filter predicts with it); None when the station does not fly the throttle
+    command_acc_mps2: float | None = None

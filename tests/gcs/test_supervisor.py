@@ -432,3 +432,18 @@ def test_intents_are_ignored_while_the_link_is_lost_except_kill() -> None:
     s.run(1.6)
     out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=2.0))
     assert s.sup.state is S.LINK_LOST and any("ignored" in n.text for n in out.notes)
+
+
+def test_the_commanded_acceleration_is_told_only_while_the_hold_flies_the_throttle() -> None:
+    s = Script()
+    s.hovering()
+    assert all(o.command_acc_mps2 is None for o in s.outs if o.state is not S.HOLD)
+    out = s.tick()
+    assert out.command is not None and out.command_acc_mps2 is not None
+    ctrl = s.sup.alt_ctrl
+    assert out.command_acc_mps2 == ctrl.accel_for_throttle(out.command.throttle_us, 0.0, 0.0)
+    s.alt = 0.9  # below the setpoint: the throttle rises, and with it what it asks for
+    up = s.run(0.5)[-1]
+    assert up.command_acc_mps2 is not None and up.command_acc_mps2 > out.command_acc_mps2
+    out = s.tick(Intent(IntentKind.KILL))
+    assert out.command_acc_mps2 is None
