@@ -80,6 +80,8 @@ class AltEstimator(ABC):
         # the estimate that judges them (a stale value fused as new holds the filter still).
         self._repeat_move_m = 0.0
         self._repeat_vel_mps = 0.0
+        # the accelerometer's own climb rate, leaking away (see climb_vel_mps)
+        self._climb_vel_mps = 0.0
         self._value_rx_s = -math.inf  # when the current value first arrived
         self._doubt_until_s = -math.inf  # repeats are not readings until then (see sonar_doubt_s)
         self._reading_late = False  # whether the reading just used was taken as a late echo
@@ -142,6 +144,7 @@ class AltEstimator(ABC):
             a = self._acc_up - self._state()[2]
             self._repeat_move_m += (self._repeat_vel_mps + 0.5 * a * dt) * dt
             self._repeat_vel_mps += a * dt
+            self._climb_vel_mps += (a - self._climb_vel_mps / p.climb_leak_s) * dt
             control_predict(self._control, self._control_accel(a, dt), dt,
                             p.control_accel_sigma_mps2)
         alt_before = self._state()[0]
@@ -149,6 +152,8 @@ class AltEstimator(ABC):
         while self._history[0][0] < t_s - p.history_s:
             self._history.popleft()
 
+        if at_rest:
+            self._climb_vel_mps = 0.0
         status = SonarStatus.NONE
         innovation = 0.0
         if sonar is not None:
@@ -376,7 +381,8 @@ class AltEstimator(ABC):
         self._reading_late = False
         in_range = sonar.valid and p.sonar_min_m <= d <= p.sonar_max_m
         if not in_range:
-            if d <= p.sonar_min_m and alt_pred < p.ground_alt_m:
+            if (d <= p.sonar_min_m and alt_pred < p.ground_alt_m
+                    and self._climb_vel_mps < p.climb_vel_mps):
                 # the HC-SR04 reads 0 below its minimum: on the floor, that *is* the altitude
                 self._correct(p.rest_alt_m, t_s)
                 self._initialised = True

@@ -285,6 +285,26 @@ def test_zero_reading_on_the_floor_means_altitude_zero() -> None:
     assert abs(alt[-1]) < 0.02
 
 
+def test_a_zero_reading_while_the_accelerometer_climbs_is_a_lost_echo_not_the_floor() -> None:
+    """Over carpet the sonar loses a fifth of its echoes, and near the floor a lost echo reads
+    0 like the floor itself. Lifting off, the accelerometer must carry the estimate up through
+    such zeros: taken as the floor, they pinned it there while the take-off ramp drove the
+    vehicle on into the ceiling."""
+    lift = smooth_step(3.0, 0.0, 1.0, 2.0)
+    for seed in range(4):
+        est = KalmanEstimator()
+        truth, alt, recs = fly(est, lift, 5.0, seed=seed, acc_noise=0.5,
+                               sonar_fn=lambda t, h: 0.0)
+        airborne = truth > 0.2
+        assert not any(r.sonar_status is SonarStatus.GROUND
+                       for r, up in zip(recs, airborne, strict=True) if up)
+        half = int(np.argmax(truth > 0.5))
+        assert alt[half] > 0.35, (seed, alt[half])
+        # standing on the floor with the rotors shaking the accelerometer, a zero is the floor
+        assert all(r.sonar_status in (SonarStatus.GROUND, SonarStatus.NONE)
+                   for r in recs[:int(3.0 / DT)])
+
+
 def test_repeated_reading_counted_as_duplicate() -> None:
     est = KalmanEstimator()
     s = Rangefinder(0.0, 1, 1.0, True, "RANGEFINDER")
