@@ -23,12 +23,14 @@ run: $(STAMP)
 # campaigns on two Ray workers would starve a wall-clock flight on the other test process.
 test: $(STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/mypy
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q -n 2 --dist loadfile --durations=25 \
 		-m "not solo"
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q -m solo
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/mypy
 
 bench: $(STAMP)
 	$(BIN)/quadgcs bench --all

@@ -10,6 +10,7 @@ expects); the v2.0 module would append them even to a MAVLink 1 frame.
 from __future__ import annotations
 
 import enum
+from typing import Any
 
 from pymavlink.dialects.v10 import ardupilotmega as mavlink1
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
@@ -35,7 +36,7 @@ def frame_overhead_bytes(wire: WireVersion, signed: bool = False) -> int:
     return FRAME_OVERHEAD_V2 + (SIGNATURE_BYTES if signed else 0)
 
 
-def message_class(name: str, wire: WireVersion = WireVersion.V2) -> type:
+def message_class(name: str, wire: WireVersion = WireVersion.V2) -> type[Any]:
     """The generated pymavlink class of message `name` (e.g. "ATTITUDE")."""
     module = mavlink1 if wire is WireVersion.V1 else mavlink
     for cls in module.mavlink_map.values():

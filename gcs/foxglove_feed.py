@@ -182,7 +182,8 @@ class FoxgloveFeed:
         return self.live_prefix + topic
 
     def _tap(self, topic: str, schema_name: str, schema: Any, log_ns: int, data: bytes) -> None:
-        # the recorder's writer thread
+        # the recorder's writer thread; tapped only with a live view (see __init__)
+        assert self.live is not None
         self.live.publish(self._live_topic(topic), schema_name, schema, log_ns, data)
 
     def _out(self, topic: str, t_s: float, payload: Any) -> None:

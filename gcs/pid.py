@@ -69,8 +69,10 @@ class PidTerms:
     saturated: bool
 
 
-def _same(a: float, b: float) -> bool:
-    """The same float, sign of zero included."""
+def _same(a: float | None, b: float | None) -> bool:
+    """The same float (or both unset), sign of zero included."""
+    if a is None or b is None:
+        return a is b
     return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
 
 

@@ -60,9 +60,10 @@ def fly_legs(profile: str, legs_m: tuple[float, ...], *, seed: int = 1,
     options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
                              fix_failsafe=True)
     results: list[LegResult] = []
-    with LockstepSession(options, config=config) as session:
+    lockstep = LockstepSession(options, config=config)
+    with lockstep as session:
         st = session.first.station
-        runner = FlightRunner(st, FlightPlan(alt_m=alt_m, hold_s=1.0), None, idle=session.tick)
+        runner = FlightRunner(st, FlightPlan(alt_m=alt_m, hold_s=1.0), None, idle=lockstep.tick)
         samples: list[tuple[float, float, float, float]] = []
 
         def sample(snap: StationSnapshot) -> None:

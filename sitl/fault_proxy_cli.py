@@ -160,8 +160,9 @@ def _apply(proxy: FaultProxy, spec: FaultSpec) -> None:
     if spec.start_s is None or spec.duration_s is None:
         proxy.set(spec.direction, **{kw: spec.value})
     else:
+        rates = {"loss": 0.0, "bitflip": 0.0, "delay_s": 0.0, kw: spec.value}
         proxy.schedule(spec.direction, spec.start_s, spec.duration_s, from_station=True,
-                       **{kw: spec.value})
+                       loss=rates["loss"], bitflip=rates["bitflip"], delay_s=rates["delay_s"])
 
 
 def run(args: argparse.Namespace) -> int:

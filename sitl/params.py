@@ -75,11 +75,11 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
         pairs = enumerate(zip(value, args, strict=True))
         return tuple(_coerce(v, a, f"{where}[{i}]") for i, (v, a) in pairs)
     if origin in (typing.Union, types.UnionType):
-        args = [a for a in typing.get_args(hint) if a is not type(None)]
+        members = [a for a in typing.get_args(hint) if a is not type(None)]
         if value is None:
             return None
-        return _coerce(value, args[0], where)
-    if dataclasses.is_dataclass(hint):
+        return _coerce(value, members[0], where)
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):
         if not isinstance(value, Mapping):
             raise ParamError(f"{where}: expected a table, got {value!r}")
         return build_dataclass(hint, value, where)

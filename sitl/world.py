@@ -309,11 +309,11 @@ def world_from_toml(data: Mapping[str, Any]) -> World:
     starts: list[Vec3] = []
     for i, s in enumerate(starts_raw):
         where = f"start_positions[{i}]"
-        n = len(s) if isinstance(s, list) else -1
-        if n not in (2, 3):
-            got = f"{n} numbers" if n >= 0 else type(s).__name__
+        size = len(s) if isinstance(s, list) else -1
+        if size not in (2, 3):
+            got = f"{size} numbers" if size >= 0 else type(s).__name__
             raise ParamError(f"{where}: expected [x, y] or [x, y, z_up], got {got}")
-        p = _numbers(s, n, where)
+        p = _numbers(s, size, where)
         if len(p) == 3:
             pos = _up_to_ned(p)
         else:  # on top of whatever stands there, else on the floor

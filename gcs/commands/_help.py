@@ -73,7 +73,8 @@ def subparsers(parser: argparse.ArgumentParser,
 def apply(parser: argparse.ArgumentParser) -> None:
     """Defaults in every flag's help and an example in every command's epilog."""
     for path, sub in subparsers(parser):
-        raw = issubclass(sub.formatter_class, argparse.RawDescriptionHelpFormatter)
+        fmt = sub.formatter_class
+        raw = isinstance(fmt, type) and issubclass(fmt, argparse.RawDescriptionHelpFormatter)
         sub.formatter_class = RawDefaultsHelpFormatter if raw else DefaultsHelpFormatter
         example = EXAMPLES.get(path)
         if example is not None and not sub.epilog:

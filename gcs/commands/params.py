@@ -74,7 +74,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_vehicle_flags(p, on_action=False)
     actions = p.add_subparsers(dest="action", metavar="ACTION", help="what to do")
-    specs: tuple[tuple[str, str, Callable[[argparse.ArgumentParser], None]], ...] = (
+    specs: tuple[tuple[str, str, Callable[[argparse.ArgumentParser], object]], ...] = (
         ("show", "list parameters (NAME VALUE, sorted)", lambda a: a.add_argument(
             "pattern", nargs="?", default="*", help="shell-style pattern, e.g. 'ATC_RAT_*'")),
         ("get", "print one parameter", lambda a: a.add_argument(

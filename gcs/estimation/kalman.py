@@ -124,12 +124,12 @@ class KalmanEstimator(AltEstimator):
         # While the sonar reads, the barometer's downwash and gust noise would only roughen a
         # better altitude (and, through the velocity, the PID's D term): it learns its offset
         # alone (a Schmidt update, the other states only "considered"), ready for the next gap.
-        k = ph[_BARO] / s
-        self._x[_BARO] += k * y
+        kb = ph[_BARO] / s
+        self._x[_BARO] += kb * y
         for j in range(_N):
             if j != _BARO:
-                P[_BARO][j] = P[j][_BARO] = P[_BARO][j] - k * ph[j]
-        P[_BARO][_BARO] += -2.0 * k * ph[_BARO] + k * k * s
+                P[_BARO][j] = P[j][_BARO] = P[_BARO][j] - kb * ph[j]
+        P[_BARO][_BARO] += -2.0 * kb * ph[_BARO] + kb * kb * s
 
     def _at_rest(self) -> None:
         self._update(_VEL, 0.0, 0.0, self.params.rest_vel_sigma_mps**2)

@@ -13,7 +13,7 @@ from typing import Any
 
 from rich.text import Text
 from textual.app import App, ComposeResult, ScreenStackError
-from textual.binding import Binding
+from textual.binding import Binding, BindingType
 from textual.containers import Horizontal
 from textual.widgets import Footer, RichLog
 
@@ -32,7 +32,7 @@ STICK_HZ = 20.0
 SETPOINT_STEP_M = 0.1
 
 
-LIVE_BINDINGS = [
+LIVE_BINDINGS: list[BindingType] = [
     Binding("a", "arm", "Arm"),
     Binding("d", "disarm", "Disarm"),
     Binding("space", "kill", "KILL", priority=True),
@@ -51,14 +51,14 @@ LIVE_BINDINGS = [
     Binding("q", "stick('yaw', -1)", "Yaw left", show=False),
     Binding("e", "stick('yaw', 1)", "Yaw right", show=False),
     ]
-REPLAY_BINDINGS = [
+REPLAY_BINDINGS: list[BindingType] = [
     Binding("p", "pause", "Play/pause"),
     Binding("right", "seek(10)", "+10 s"),
     Binding("left", "seek(-10)", "-10 s"),
     Binding("plus", "speed(2)", "Faster"),
     Binding("minus", "speed(0.5)", "Slower"),
     ]
-COMMON_BINDINGS = [
+COMMON_BINDINGS: list[BindingType] = [
     Binding("question_mark", "help", "Help"),
     Binding("ctrl+c,ctrl+q", "quit", "Quit", priority=True),
     ]
