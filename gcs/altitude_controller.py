@@ -54,6 +54,10 @@ class AltitudeControllerParams:
     hover_learn_tc_s: float = 10.0
     hover_learn_max_vel_mps: float = 0.2
     hover_learn_max_err_m: float = 0.1
+    # All the climb the loop may ask (the output or the stick at its top, or P at its leash
+    # with the integrator this near its limit), yet rising slower than this: blocked
+    blocked_climb_i_share: float = 0.9
+    blocked_climb_vel_mps: float = 0.1
     hover_min: float = 0.15
     hover_max: float = 0.8
     throttle_min_us: int = 1000
@@ -97,6 +101,9 @@ class AltitudeController:
         # which way the last stick command was clamped (+1 at the top, -1 at the bottom): the
         # integrator must not keep growing into a stick that cannot move further
         self._clamped = 0
+        # how long the loop has asked for all the climb it may while the estimate did not rise
+        # (see SupervisorParams.blocked_climb_s)
+        self.blocked_climb_s = 0.0
 
     def _tilt(self, roll_rad: float, pitch_rad: float) -> float:
         c = math.cos(roll_rad) * math.cos(pitch_rad)
@@ -116,6 +123,7 @@ class AltitudeController:
         alt = _flown_alt(estimate)
         self.pid.engage(alt, alt, a0)
         self._clamped = 0
+        self.blocked_climb_s = 0.0
 
     def surface_changed(self, jump_m: float) -> None:
         """The estimate jumped by `jump_m` because the sonar now measures from another surface
@@ -151,6 +159,11 @@ class AltitudeController:
         stick = self.curve.stick_us(motor)
         throttle_us = round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
         self._clamped = 1 if stick > p.throttle_max_us else -1 if stick < p.throttle_min_us else 0
+        g = p.gains
+        full = (self._clamped > 0 or (terms.saturated and terms.out > 0.0)
+                or (terms.error >= g.error_max and terms.i >= p.blocked_climb_i_share * g.i_max))
+        blocked = full and not on_floor and vel < p.blocked_climb_vel_mps
+        self.blocked_climb_s = self.blocked_climb_s + dt_s if blocked else 0.0
         if not on_floor:  # on the floor the throttle says nothing about the hover throttle
             self._learn_hover(motor * tilt, terms, estimate, dt_s)
         return AltControlOutput(

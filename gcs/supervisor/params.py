@@ -57,6 +57,12 @@ class SupervisorParams:
     liftoff_lag_s: float = 0.3  # the ramp's last stretch, spent before lift-off was seen
     pickup_band_us: int = 25  # the pilot's throttle takes over within this of the held one
     quit_timeout_s: float = 10.0  # a quitting station waits this long for LAND to show
+    # The hold asking for nearly all the climb it may (AltitudeControllerParams) this long
+    # while the estimate does not rise: a vehicle given +3 m/s² for a second climbs 3 m/s, so
+    # either the estimate is not the vehicle's (it was pinned to the floor of a carpet while the
+    # take-off drove the vehicle into the ceiling) or the thrust is gone. Either way the PC
+    # cannot fly it: the vehicle's own LAND takes over, as ArduCopter's thrust-loss check does.
+    blocked_climb_s: float = 2.0
     # The firmware disarms by itself once landed with the throttle at minimum this long:
     # 3.2.1's AUTO_DISARMING_DELAY is a compile-time 15 s; 4.x's DISARM_DELAY defaults to 10 s.
     # Whatever arms a vehicle on the floor must take off (or disarm it) well before.

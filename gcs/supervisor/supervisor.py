@@ -42,6 +42,7 @@ from gcs.supervisor.types import (
     SupervisorState,
     TickIn,
     Transition,
+    mode_name,
 )
 
 S = SupervisorState
@@ -50,13 +51,6 @@ LANDING_MODES = frozenset({FlightMode.LAND, FlightMode.RTL, FlightMode.AUTO, Fli
 """Modes that ignore the throttle stick (or use it only to disarm): send it at minimum."""
 MANUAL_THROTTLE_MODES = frozenset({FlightMode.STABILIZE, FlightMode.ACRO})
 LEVEL = RcCommand(STICK_MID_US, STICK_MID_US, STICK_MIN_US, STICK_MID_US)
-
-
-def _mode_name(mode: int) -> str:
-    try:
-        return FlightMode(mode).name
-    except ValueError:
-        return f"mode {mode}"
 
 
 class Supervisor:
@@ -74,6 +68,7 @@ class Supervisor:
         self.sticks = RcCommand()
         self.command = LEVEL
         self.requested_mode: int | None = None
+        self._asked_why = "as asked"  # why the station asked for requested_mode
         self.preflight_ok = False
         self.preflight_note = "pre-flight checks not run"
         self.alt_target_m: float | None = None
@@ -202,9 +197,9 @@ class Supervisor:
             self._actions.append(Action(ActionKind.DISARM))
             self._note(Level.INFO, "disarm requested")
         elif k is IntentKind.SET_MODE:
-            self.requested_mode = it.mode
+            self.requested_mode, self._asked_why = it.mode, "as asked"
             self._actions.append(Action(ActionKind.SET_MODE, it.mode))
-            self._note(Level.INFO, f"mode {_mode_name(it.mode)} requested")
+            self._note(Level.INFO, f"mode {mode_name(it.mode)} requested")
         elif k is IntentKind.ALT_HOLD:
             self._alt_hold(it, inp)
         elif k is IntentKind.ALT_HOLD_OFF:
@@ -230,7 +225,7 @@ class Supervisor:
     def _alt_hold(self, it: Intent, inp: TickIn) -> None:
         if self.state in (S.DISARMED, S.ARMING, S.VEHICLE):
             why = ("arm first" if self.state is not S.VEHICLE else
-                   f"the vehicle flies itself in {_mode_name(inp.vehicle.mode)}; "
+                   f"the vehicle flies itself in {mode_name(inp.vehicle.mode)}; "
                    "switch to STABILIZE first")
             if self.state is S.ARMING:
                 self._takeoff_wanted = True
@@ -245,7 +240,7 @@ class Supervisor:
             return
         if inp.vehicle.mode != FlightMode.STABILIZE:
             self._note(Level.WARNING, "altitude hold refused: the PC flies in STABILIZE, the "
-                       f"vehicle is in {_mode_name(inp.vehicle.mode)}")
+                       f"vehicle is in {mode_name(inp.vehicle.mode)}")
             return
         self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
         if self.state is S.MANUAL:
@@ -320,24 +315,24 @@ class Supervisor:
 
     def _watch_mode(self, mode: int) -> None:
         asked = self.requested_mode == mode
-        how = "as asked" if asked else "by itself"
+        how = self._asked_why if asked else "by itself"
         st = self.state
         if st in PC_CONTROL:
             if mode != FlightMode.STABILIZE:
                 self._end_pc_control()
-                self._go(S.VEHICLE, f"vehicle in {_mode_name(mode)} {how}: PC control off",
+                self._go(S.VEHICLE, f"vehicle in {mode_name(mode)} {how}: PC control off",
                          Level.INFO if asked else Level.WARNING)
         elif st is S.MANUAL:
             if mode in LANDING_MODES or (not asked and mode not in MANUAL_THROTTLE_MODES
                                          and self.requested_mode is not None):
-                self._go(S.VEHICLE, f"vehicle in {_mode_name(mode)} {how}",
+                self._go(S.VEHICLE, f"vehicle in {mode_name(mode)} {how}",
                          Level.INFO if asked else Level.WARNING)
         elif st is S.VEHICLE:
             if mode in MANUAL_THROTTLE_MODES:
-                self._to_manual(f"vehicle in {_mode_name(mode)} {how}: throttle held at minimum "
+                self._to_manual(f"vehicle in {mode_name(mode)} {how}: throttle held at minimum "
                                 "until the pilot's stick comes down to it", STICK_MIN_US)
             elif asked and mode not in LANDING_MODES:
-                self._to_manual(f"vehicle in {_mode_name(mode)} as asked", None)
+                self._to_manual(f"vehicle in {mode_name(mode)} as asked", None)
 
     # ------------------------------------------------------------------ commands per state
     def _run(self, inp: TickIn) -> tuple[RcCommand | None, bool]:
@@ -477,6 +472,14 @@ class Supervisor:
         floor = self.on_floor(est.alt_m) and self.alt_setpoint_m <= est.alt_m
         self.alt = self.alt_ctrl.update(self.alt_setpoint_m, est, inp.roll_rad, inp.pitch_rad,
                                         inp.dt_s, on_floor=floor, rate_mps=self.alt_rate_mps)
+        blocked = self.alt_ctrl.blocked_climb_s
+        if blocked >= self.p.blocked_climb_s and self.state is S.HOLD:
+            if blocked - inp.dt_s < self.p.blocked_climb_s:
+                self._note(Level.ERROR, f"full climb asked for {blocked:.1f} s and the estimate "
+                           "did not rise: the estimate is not the vehicle's, or thrust is "
+                           "lost: LAND")
+            self.requested_mode, self._asked_why = FlightMode.LAND, "asked: no rise at full climb"
+            self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
         s = self.sticks
         roll, pitch, yaw = s.roll_us, s.pitch_us, s.yaw_us
         self.position = None

@@ -10,7 +10,7 @@ import enum
 import math
 from dataclasses import dataclass
 
-from firmware_link.records import MocapPose, RcCommand
+from firmware_link.records import FlightMode, MocapPose, RcCommand
 from gcs.estimation import AltEstimate
 
 STICK_MIN_US, STICK_MID_US, STICK_MAX_US = 1000, 1500, 2000
@@ -172,3 +172,11 @@ class SupervisorOutput:
     # HOLD: the vertical acceleration the command's throttle asks of the vehicle (the hold's
     # filter predicts with it); None when the station does not fly the throttle
     command_acc_mps2: float | None = None
+
+
+def mode_name(mode: int) -> str:
+    """A custom mode's name, as the pilot knows it."""
+    try:
+        return FlightMode(mode).name
+    except ValueError:
+        return f"mode {mode}"

@@ -100,6 +100,7 @@ def test_grid_results_resume_and_a_failing_run(tmp_path: Path, ray: Any) -> None
 
     # the same file again flies nothing; a new value flies only its own runs, and a hover
     # clamp below the vehicle's hover throttle is a flight that fails: a row with its reason
+    # (the hold strains at full climb with no rise, and hands the vehicle to its own LAND)
     again = run_campaign(c, out, ray, quiet=True)
     assert (again.ran, again.skipped) == (0, 6)
     grown = load_campaign(_file(tmp_path, GRID + '"station.altitude.hover_max" = [0.8, 0.3]\n'
@@ -110,7 +111,8 @@ def test_grid_results_resume_and_a_failing_run(tmp_path: Path, ray: Any) -> None
     failed = [r for r in rows if r["status"] == "failed"]
     assert len(rows) == 18 and len(failed) == 6
     assert all(r["station.altitude.hover_max"] == 0.3 for r in failed)
-    assert all("did not happen" in r["reason"] and math.isnan(r["rms_error_m"]) for r in failed)
+    assert all("no rise at full climb" in r["reason"] and math.isnan(r["rms_error_m"])
+               for r in failed)
 
 
 @pytest.mark.timeout(240)

@@ -447,3 +447,33 @@ def test_the_commanded_acceleration_is_told_only_while_the_hold_flies_the_thrott
     assert up.command_acc_mps2 is not None and up.command_acc_mps2 > out.command_acc_mps2
     out = s.tick(Intent(IntentKind.KILL))
     assert out.command_acc_mps2 is None
+
+
+def test_full_climb_with_no_rise_hands_the_vehicle_to_its_own_land() -> None:
+    """An estimate stuck below the vehicle (or thrust gone): the hold asks for all the climb
+    it may and nothing rises. Two seconds of that, and LAND is asked until it shows."""
+    s = Script()
+    s.hovering()
+    s.alt, s.vel = 0.5, -0.05  # well below the setpoint, and not rising
+    outs = s.run(10.0)
+    lands = [o for o in outs if any(a.kind is ActionKind.SET_MODE and a.mode == FlightMode.LAND
+                                    for a in o.actions)]
+    assert len(lands) >= 2  # repeated until the heartbeat shows it
+    first = outs.index(lands[0])
+    assert s.sup.alt_ctrl.blocked_climb_s >= 2.0
+    assert any("estimate did not rise" in n.text for n in outs[first].notes)
+    assert sum("estimate did not rise" in n.text for o in outs for n in o.notes) == 1
+    s.mode = int(FlightMode.LAND)
+    s.heartbeat_now()
+    out = s.tick()
+    assert out.state is S.VEHICLE and s.sup.alt is None
+    assert out.command is not None and out.command.throttle_us == 1000
+
+
+def test_a_climb_that_answers_is_not_blocked() -> None:
+    s = Script()
+    s.hovering()
+    s.alt, s.vel = 0.5, 0.3  # far below, but climbing as asked
+    outs = s.run(10.0)
+    assert not any(a.kind is ActionKind.SET_MODE for o in outs for a in o.actions)
+    assert s.sup.state is S.HOLD
