@@ -90,7 +90,7 @@ def thesis_table() -> bool:
 
 def noisy_thesis(seeds: int) -> None:
     """EPBHA on the thesis scenes with the SITL's 1 cm IR noise floor, several seeds each."""
-    params = ProximityParams(noise_sigma_m=0.01)
+    params = ProximityParams(noise_sigma_m=0.01, exact=True)
     print()
     print(f"EPBHA with 1 cm IR noise (sigma), {seeds} seeds per scene")
     for scene in thesis_scenes():

@@ -60,9 +60,13 @@ Where this code departs from the text, and why:
   past that edge inside the body radius. A move is taken only when the swept body also clears
   every return of the last few readings, each taken anywhere on its cone's cap unless a later
   free cone rules that part out (:mod:`planners.return_memory`); a manoeuvre blocked only by
-  such a memory widens its berth sideways.
+  such a memory widens its berth sideways. A box edge can also hide from every reading at
+  once, between the cone ahead and a side cone that each see one of its faces at their rims:
+  the two readings place the nearest such edge, and a move must pass it by
+  `wedge_clearance_m` (:mod:`planners.epbha_wedges`).
 
-`run_epbha` (:mod:`planners.epbha_run`) flies the planner in the kinematic world.
+`run_epbha` (:mod:`planners.epbha_run`) flies the planner in the kinematic world, whose cones
+report the nearest surface anywhere inside them, as the memory takes a reading to mean.
 """
 
 from __future__ import annotations
@@ -71,7 +75,7 @@ import math
 from collections import Counter
 from dataclasses import dataclass, field
 
-from planners.epbha_manoeuvre import Manoeuvre
+from planners.epbha_manoeuvre import Manoeuvre, keep_off_move
 from planners.epbha_types import (
     AXIS_MOVES,
     CostEntry,
@@ -83,6 +87,7 @@ from planners.epbha_types import (
     Reason,
     Status,
 )
+from planners.epbha_wedges import wedge_clear
 from planners.geometry import Vec3
 from planners.proximity import ProximityReading
 from planners.return_memory import ReturnMemory
@@ -201,9 +206,14 @@ class Epbha:
 
     def _free(self, pos: Vec3, reading: ProximityReading, move: Move) -> bool:
         """The move's sensor sees nothing near and the swept body clears every return seen."""
-        return self._sensor_free(reading, move) and self._clear_of_memory(
-            pos, self._neighbour(pos, move)
-        )
+        return self._sensor_free(reading, move) and self._clear_of_seen(pos, reading, move)
+
+    def _clear_of_seen(self, pos: Vec3, reading: ProximityReading, move: Move) -> bool:
+        """The swept body clears remembered returns and the edges blind wedges may hide."""
+        p = self.params
+        return self._clear_of_memory(pos, self._neighbour(pos, move)) and wedge_clear(
+            reading, move, p.step_m, p.wedge_clearance_m, p.swept_z_scale, p.sensor_cone_deg,
+            p.sensor_range_m)
 
     def _clear_of_memory(self, pos: Vec3, next_pos: Vec3) -> bool:
         """No remembered return can lie within the body radius of the move's path.
@@ -322,30 +332,9 @@ class Epbha:
     # --- manoeuvres -------------------------------------------------------------------
 
     def _keep_off(self, pos: Vec3, reading: ProximityReading) -> Move | None:
-        """The move away from anything nearer than keep_off, when that evens the gap.
-
-        In a gap narrower than twice keep_off (the goal under a table), backing off one side
-        would only bring the other side near: the move is taken only when the far side stays
-        farther than the near side after it, so keep-off never oscillates.
-        """
-        nearest: tuple[float, Move] | None = None
-        for move in Move:
-            seen = reading.along_n(move.vec())
-            if seen is not None and seen < self.params.keep_off(move) - 1e-9 and (
-                nearest is None or seen < nearest[0]
-            ):
-                nearest = (seen, move)
-        if nearest is None:
-            return None
-        away = nearest[1].opposite
-        if away is Move.UP and -pos[2] + self.params.step_m > self.params.max_alt_m + 1e-9:
-            return None
-        far = reading.along_n(away.vec())
-        if (far is None or far > nearest[0] + 2.0 * self.params.step_m + 1e-9) and (
-            self._clear_of_memory(pos, self._neighbour(pos, away))
-        ):
-            return away
-        return None
+        """The move away from anything nearer than keep-off (:func:`keep_off_move`)."""
+        return keep_off_move(self.params, pos, reading,
+                             lambda away: self._clear_of_seen(pos, reading, away))
 
     def _start_manoeuvre(
         self,

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from planners.epbha_types import EpbhaParams, Move, ObstacleClass
+from planners.geometry import Vec3
 from planners.proximity import ProximityReading
 
 
@@ -41,3 +43,31 @@ class Manoeuvre:
         half = math.radians(params.sensor_cone_deg) / 2.0
         short_m = params.body_radius_m - self.last_seen_m * math.tan(half)
         return max(0, math.ceil(short_m / params.step_m - 1e-9))
+
+
+def keep_off_move(
+    params: EpbhaParams, pos: Vec3, reading: ProximityReading, clear: Callable[[Move], bool]
+) -> Move | None:
+    """The move away from anything nearer than keep_off, when that evens the gap.
+
+    In a gap narrower than twice keep_off (the goal under a table), backing off one side
+    would only bring the other side near: the move is taken only when the far side stays
+    farther than the near side after it, so keep-off never oscillates. `clear` says whether
+    the swept body of a move clears what has been seen.
+    """
+    nearest: tuple[float, Move] | None = None
+    for move in Move:
+        seen = reading.along_n(move.vec())
+        if seen is not None and seen < params.keep_off(move) - 1e-9 and (
+            nearest is None or seen < nearest[0]
+        ):
+            nearest = (seen, move)
+    if nearest is None:
+        return None
+    away = nearest[1].opposite
+    if away is Move.UP and -pos[2] + params.step_m > params.max_alt_m + 1e-9:
+        return None
+    far = reading.along_n(away.vec())
+    if (far is None or far > nearest[0] + 2.0 * params.step_m + 1e-9) and clear(away):
+        return away
+    return None

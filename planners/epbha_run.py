@@ -31,7 +31,10 @@ def run_epbha(
     if world.clearance(start_n) == 0.0:
         return PlanResult("EPBHA", PlanStatus.START_BLOCKED, (start_n,), 0, 0, (), 0.0,
                           0, "start is inside an obstacle or outside the room")
-    proximity = proximity or ProximityParams(range_m=params.sensor_range_m)
+    # The planner's memory reads "nothing seen" as "nothing anywhere in the cone"; rays that
+    # can miss an edge poking in between them would break that (planners.cone).
+    proximity = proximity or ProximityParams(range_m=params.sensor_range_m,
+                                             cone_deg=params.sensor_cone_deg, exact=True)
     sim = KinematicSim(world, start_n, kinematic or KinematicParams(), proximity, rng)
     planner = Epbha(params, goal_n, start_n)
     cpu: list[float] = []

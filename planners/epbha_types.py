@@ -112,6 +112,10 @@ class EpbhaParams:
     # The same above and below (None: swept_clearance_m). The flat body's vertical need is its
     # half-height plus the height hold's error: a table top 0.2 m over the sensors is clear.
     swept_clearance_vertical_m: float | None = None
+    # A move must pass this far from the edge a blind wedge beside it may hide
+    # (planners.epbha_wedges): the 0.15 m body plus 1 cm, less margin than for a return
+    # remembered, as that edge is placed as near as the readings allow, never farther.
+    wedge_clearance_m: float = 0.16
     # Returns are remembered for this many readings (0.3 m of travel): long enough to keep an
     # edge that slipped into a blind wedge, short enough that a cap's rim, never resolved across
     # the plane the vehicle moves in, does not shut passages it has already measured.
@@ -139,8 +143,9 @@ class EpbhaParams:
             raise ValueError(f"EPBHA max_alt_m must be > 0, got {self.max_alt_m}")
         if self.body_radius_m < 0.0 or self.max_visits < 1:
             raise ValueError("EPBHA body_radius_m must be >= 0 and max_visits >= 1")
-        if self.swept_clearance_m < 0.0:
-            raise ValueError(f"EPBHA swept_clearance_m must be >= 0, got {self.swept_clearance_m}")
+        for name in ("swept_clearance_m", "wedge_clearance_m"):
+            if getattr(self, name) < 0.0:
+                raise ValueError(f"EPBHA {name} must be >= 0, got {getattr(self, name)}")
         v = self.swept_clearance_vertical_m
         if v is not None and not v > 0.0:
             raise ValueError(f"EPBHA swept_clearance_vertical_m must be > 0, got {v}")

@@ -2,8 +2,10 @@
 
 The sensors are body-fixed (FRD). The thesis's UAV keeps its yaw fixed and re-orients the sensor
 indexes by its direction of travel instead of turning (Subfunction 2); `ProximityReading.along_n`
-does that re-orientation for any yaw. Simulated sensing casts a few rays per cone and reports the
-nearest return, as an IR ranger reports the strongest (nearest) echo in its field of view.
+does that re-orientation for any yaw. A sensor reports the nearest return, as an IR ranger
+reports the strongest (nearest) echo in its field of view. Simulated sensing either finds that
+nearest point exactly (`ProximityParams.exact`, :mod:`planners.cone`) or casts a few rays per
+cone, which is cheaper but can miss an edge that pokes into the cone between two rays.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planners.cone import boxes_in_cone_m, room_in_cone_m
 from planners.geometry import Vec3, World
 
 
@@ -49,6 +52,9 @@ class ProximityParams:
     rings: int = 2  # rings of rays around the axis, out to the cone edge
     rays_per_ring: int = 8
     noise_sigma_m: float = 0.0  # the thesis assumes exact readings; SITL worlds add >= 0.01
+    # The nearest surface anywhere inside the cone (the thesis's sensor, and what EPBHA's memory
+    # takes a reading to mean) instead of the nearest of the rays above.
+    exact: bool = False
 
     def __post_init__(self) -> None:
         if not self.range_m > 0.0:
@@ -177,13 +183,18 @@ def sense(
     params = params or ProximityParams()
     c, s = math.cos(yaw_rad), math.sin(yaw_rad)
     values: dict[Facing, float | None] = {}
+    exact = _ExactCones(world, pos_n, params) if params.exact else None
     for facing in Facing:
         nearest: float | None = None
-        for fx, fy, fz in _rays_for(facing, params):
-            ray_n = (c * fx - s * fy, s * fx + c * fy, fz)
-            hit = world.ray_cast(pos_n, ray_n, params.range_m if nearest is None else nearest)
-            if hit is not None and (nearest is None or hit < nearest):
-                nearest = hit
+        if exact is not None:
+            fx, fy, fz = AXIS_B[facing]
+            nearest = exact.nearest((c * fx - s * fy, s * fx + c * fy, fz))
+        else:
+            for fx, fy, fz in _rays_for(facing, params):
+                ray_n = (c * fx - s * fy, s * fx + c * fy, fz)
+                hit = world.ray_cast(pos_n, ray_n, params.range_m if nearest is None else nearest)
+                if hit is not None and (nearest is None or hit < nearest):
+                    nearest = hit
         if nearest is not None and rng is not None and params.noise_sigma_m > 0.0:
             nearest = min(params.range_m, max(0.0, nearest + rng.normal(0.0, params.noise_sigma_m)))
         values[facing] = nearest
@@ -193,3 +204,30 @@ def sense(
 @functools.lru_cache(maxsize=64)
 def _rays_for(facing: Facing, params: ProximityParams) -> tuple[Vec3, ...]:
     return tuple(cone_rays_b(facing, params))
+
+
+class _ExactCones:
+    """The boxes within sensor range of one position, ready for exact cone queries."""
+
+    def __init__(self, world: World, pos_n: Vec3, params: ProximityParams) -> None:
+        self._room, self._pos = world.room, pos_n
+        self._in_room = world.room.contains(pos_n)
+        self._half = math.radians(params.cone_deg) / 2.0
+        self._range = params.range_m
+        p = np.asarray(pos_n, dtype=float)
+        near = [b for b in world.obstacles if b.distance_to_point(pos_n) <= params.range_m]
+        self._lo = np.array([b.min_n for b in near], dtype=float).reshape(-1, 3) - p
+        self._hi = np.array([b.max_n for b in near], dtype=float).reshape(-1, 3) - p
+
+    def nearest(self, axis_n: Vec3) -> float | None:
+        """The nearest obstacle or wall point inside the cone about `axis_n`, within range."""
+        found = [
+            d
+            for d in (
+                boxes_in_cone_m(self._lo, self._hi, axis_n, self._half),
+                room_in_cone_m(self._room, self._pos, axis_n, self._half)
+                if self._in_room else None,
+            )
+            if d is not None and d <= self._range
+        ]
+        return min(found, default=None)

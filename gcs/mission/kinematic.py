@@ -69,8 +69,9 @@ def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
     t0 = time.monotonic()
     params = setup.params
     start = _at_altitude(start_of(spec, mw, 0), spec.takeoff_alt_m)
+    # the nearest surface anywhere in each cone, as EPBHA's memory takes a reading to mean
     prox = ProximityParams(range_m=params.sensor_range_m, cone_deg=params.sensor_cone_deg,
-                           noise_sigma_m=setup.noise_sigma_m)
+                           noise_sigma_m=setup.noise_sigma_m, exact=True)
     sim = KinematicSim(mw.world, start, KinematicParams(), prox,
                        np.random.default_rng(setup.seed))
     rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
