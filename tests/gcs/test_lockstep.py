@@ -117,3 +117,20 @@ def test_link_faults_are_refused_off_lockstep(tmp_path: Path) -> None:
     with pytest.raises(UsageError, match="lockstep only"):
         run_mission(load_mission(mission), RunOptions(output=tmp_path, link_faults={
             "fade": "both"}), None)
+
+
+@pytest.mark.parametrize("seed", [4, 7])
+def test_a_lossy_radio_still_reads_the_preflight_parameters_and_flies(seed: int) -> None:
+    """A fifth of the frames lost both ways from power-on: every parameter request and its
+    answer must get through one of the tries before the pre-flight deadline. (Tried once a
+    second, these seeds lost every try of one parameter and the flight never armed.)"""
+    from gcs.commands.fly import fly_session
+    from gcs.flight import FlightPlan
+    from gcs.lockstep_session import LockstepSession
+    from gcs.session import SessionOptions
+
+    options = SessionOptions(command="fly", profile="apm25", seed=seed, record=False)
+    with LockstepSession(options, faults={"loss": 0.2}) as session:
+        summary = fly_session(session, FlightPlan(alt_m=1.0, hold_s=5.0), pilot_signals=False)
+    assert summary["status"] == "ok", summary
+    assert summary["lost_messages"] > 0  # the radio did lose frames
