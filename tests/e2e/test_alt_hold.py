@@ -33,9 +33,10 @@ def fly_json(*argv: str) -> dict[str, Any]:
     # the starved-SITL test below for what the estimator does with such bursts)
     pytest.param("tcp", marks=pytest.mark.solo),
     pytest.param("serial", marks=pytest.mark.xfail(
-        strict=False, reason="a 115200-baud line carries the telemetry at 16.7 Hz (3.2.1 "
-        "streams at 50/N Hz within the byte budget), and the 1 m step settles in about 4.8 s, "
-        "not 4 s (open)")),
+        strict=False, reason="on the 115200-baud line (telemetry at 16.7 Hz) the step settles "
+        "in 1.2 s alone (seed 3, 2x, both profiles), but this flight runs beside the other "
+        "test process's wall-clock flights, and a starved SITL's telemetry bursts have made "
+        "such a step overshoot (a TCP one: 96 %, so those run alone)")),
 ])
 def test_holds_1m_and_settles_a_1m_step(transport: str, profile: str) -> None:
     """Over TCP, and over the product's own case: an APM 2.5 (or a 4.x board) on a 115200-baud

@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import pytest
-
+from gcs import topics as theirs
 from logs import topics as ours
 
 
 def test_station_topic_names_match() -> None:
-    theirs = pytest.importorskip("gcs.topics")
     assert ours.ESTIMATE_TOPIC == theirs.ESTIMATE
     assert ours.ALT_CONTROLLER_TOPIC == theirs.ALT_CONTROLLER
     assert ours.RC_OVERRIDE_TOPIC == theirs.RC_OVERRIDE
