@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 from firmware_link.records import FlightMode
 from gcs.errors import FlightFailed
+from gcs.estimation import EstimatorCounts
 from gcs.position_controller import PositionSetpoint, yaw_from_quat
 from gcs.scoring import (
     ESTIMATE,
@@ -127,6 +128,7 @@ class FlightSummary:
     corrupted: int
     hover_throttle: float
     samples: tuple[FlightSample, ...] = field(repr=False)
+    estimator: EstimatorCounts | None = None
 
 
 def _truth_alt(snap: StationSnapshot) -> float | None:
@@ -352,6 +354,7 @@ class FlightRunner:
             corrupted=int(getattr(stats, "bad_frames", 0)),
             hover_throttle=snap.hover_throttle,
             samples=tuple(self.samples),
+            estimator=self.station.estimator.counts(),
         )
 
     def truth_origin_m(self) -> float | None:

@@ -120,6 +120,8 @@ def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> 
         "dialect": dialect.value,
         "recording": recording,
     }
+    if s.estimator is not None:
+        d["estimator"] = dataclasses.asdict(s.estimator)
     if s.step is not None:
         d["step"] = {
             "step_m": s.step.step_m,
@@ -152,6 +154,12 @@ def _print_summary(d: dict[str, Any]) -> None:
           f"of {d['ticks']} ticks")
     print(f"link ({d['dialect']}): {d['rx_messages']} messages received, "
           f"{d['lost_messages']} lost, {d['corrupted_frames']} corrupted")
+    if "estimator" in d:
+        e = d["estimator"]
+        print(f"estimator set aside: {e['sonar_rejected']} sonar readings (gate), "
+              f"{e['imu_repeats']} IMU samples received twice, {e['implausible_times']} "
+              f"stamped ahead of the station's clock; {e['late_bursts']} late bursts "
+              "integrated at their own times")
     print(f"learned hover throttle {d['hover_throttle']:.3f}")
     if "forward" in d:
         f = d["forward"]

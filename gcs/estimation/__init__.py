@@ -2,7 +2,7 @@
 a third-order complementary filter (as APM's inertial navigation) and a Kalman filter that also
 fuses the barometer to bridge the sonar's gaps over carpet."""
 
-from gcs.estimation.base import AltEstimate, AltEstimator, SonarStatus
+from gcs.estimation.base import AltEstimate, AltEstimator, EstimatorCounts, SonarStatus
 from gcs.estimation.complementary import ComplementaryEstimator
 from gcs.estimation.dead_reckoning import DeadReckoningEstimator
 from gcs.estimation.inputs import (
@@ -20,6 +20,7 @@ __all__ = [
     "AltEstimator",
     "ComplementaryEstimator",
     "DeadReckoningEstimator",
+    "EstimatorCounts",
     "EstimatorParams",
     "KalmanEstimator",
     "SonarStatus",

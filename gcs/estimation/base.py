@@ -36,6 +36,16 @@ class SonarStatus(enum.Enum):
 
 
 @dataclass(frozen=True, slots=True)
+class EstimatorCounts:
+    """What the estimator set aside over a flight, so that a summary can say so."""
+
+    sonar_rejected: int  # readings that failed the innovation gate
+    late_bursts: int  # telemetry bursts integrated again at their samples' own times
+    imu_repeats: int  # IMU samples the link delivered twice (integrated once)
+    implausible_times: int  # samples stamped ahead of the station's clock (not learned from)
+
+
+@dataclass(frozen=True, slots=True)
 class AltEstimate:
     """Altitude estimate (up positive) and its diagnostics."""
 
@@ -247,6 +257,10 @@ class AltEstimator(ABC):
     def imu_dropped(self) -> int:
         """IMU samples the link delivered twice (integrated once)."""
         return self._catch_up.dropped
+
+    def counts(self) -> EstimatorCounts:
+        c = self._catch_up
+        return EstimatorCounts(self._rejected_total, c.replays, c.dropped, c.implausible)
 
     def snapshot(self) -> object:
         """The filter's state, to be put back by `restore` (its containers copied)."""

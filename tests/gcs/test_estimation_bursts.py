@@ -185,6 +185,7 @@ def test_a_frame_delivered_twice_is_integrated_once_and_counted() -> None:
         assert (a.alt_m, a.vel_mps) == (b.alt_m, b.vel_mps)
     assert twice.imu_dropped == 1 and once.imu_dropped == 0
     assert twice.burst_replays == 0
+    assert twice.counts().imu_repeats == 1 and once.counts().imu_repeats == 0
 
 
 def test_a_garbled_vehicle_time_neither_replays_nor_stops_the_catching_up() -> None:
@@ -198,6 +199,7 @@ def test_a_garbled_vehicle_time_neither_replays_nor_stops_the_catching_up() -> N
         r = est.update_tick([_imu(t, garbled, rest)], [], att, t)
         assert math.isfinite(r.alt_m) and abs(r.alt_m - 1.0) < 0.05
     assert est.burst_replays == 0
+    assert est.counts().implausible_times == 1  # the one far ahead, counted for the summary
     for _ in range(6):  # and a real burst after them is still caught up
         t += DT
         est.update_tick([], [], att, t)

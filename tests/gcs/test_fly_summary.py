@@ -10,6 +10,7 @@ import pytest
 
 from firmware_link.records import Dialect
 from gcs.commands.fly import _print_summary, _summary_dict
+from gcs.estimation import EstimatorCounts
 from gcs.flight import FlightSummary
 
 BASE = FlightSummary(
@@ -50,3 +51,13 @@ def test_text_for_an_unscored_hold(capsys: pytest.CaptureFixture[str]) -> None:
     s = dataclasses.replace(BASE, error_source="none", rms_error_m=math.nan)
     _print_summary(_summary_dict(s, None, Dialect.APM25))
     assert "not scored" in capsys.readouterr().out
+
+
+def test_what_the_estimator_set_aside_is_reported(capsys: pytest.CaptureFixture[str]) -> None:
+    s = dataclasses.replace(BASE, estimator=EstimatorCounts(7, 2, 3, 1))
+    d = _summary_dict(s, None, Dialect.APM25)
+    assert d["estimator"] == {"sonar_rejected": 7, "late_bursts": 2, "imu_repeats": 3,
+                              "implausible_times": 1}
+    _print_summary(d)
+    out = capsys.readouterr().out
+    assert "7 sonar readings (gate), 3 IMU samples received twice, 1 stamped ahead" in out
