@@ -8,7 +8,8 @@ ground-truth endpoint (every 50 Hz report; `gcs.scoring`): RMS against the setpo
    Floors: jitter p99 <= 1 ms and 0 overruns.
 2. Short holds (`--compare-s`, default 30, at `--compare-alt`, default 2 m) with each estimator
    (`--estimators`): the thesis's eq. 6.1 dead reckoning, the third-order complementary filter
-   and the Kalman filter, each with a 1 m step.
+   and the Kalman filter, each with a 1 m step: up from below 2 m, down from 2 m and above
+   (the default room's ceiling is at 3 m; a step up from 2 m would end against it).
 3. The same short hold flown by the bundled SITL's onboard ALT_HOLD (the station keeps the
    sticks centred, then asks for LAND), against the PC loop's Kalman row by RMS against the
    target and by std about its own mean, and the PC loop's std against what the real
@@ -88,12 +89,18 @@ def describe(r: Mapping[str, Any]) -> str:
             f"worst {r['max_cm']:.2f} cm [{src}]")
 
 
+def compare_step_m(alt_m: float) -> float:
+    """The short holds' 1 m step: down from 2 m and above, clear of the 3 m ceiling."""
+    return 1.0 if alt_m < 2.0 else -1.0
+
+
 def pc_flight(profile: str, kind: EstimatorKind, alt_m: float, hold_s: float,
               seed: int) -> dict[str, Any]:
     """Fly the PC loop with one estimator; the summary's numbers plus CPU per tick."""
     with session(profile, kind, seed) as v:
         st = v.station
-        runner = FlightRunner(st, FlightPlan(alt_m=alt_m, hold_s=hold_s, step_m=1.0))
+        runner = FlightRunner(st, FlightPlan(alt_m=alt_m, hold_s=hold_s,
+                                             step_m=compare_step_m(alt_m)))
         cpu0, ticks0 = time.process_time(), st.snapshot().loop.ticks
         runner.fly()
         cpu1, snap = time.process_time(), st.snapshot()
@@ -208,7 +215,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"    compute per tick p50 {r['compute_p50_ms']:.3f} ms, p99 "
                   f"{r['compute_p99_ms']:.3f} ms; process CPU {r['cpu_per_tick_ms']:.3f} "
                   f"ms/tick")
-        print(f"\n[2] estimators, {args.compare_s:g} s hold at {alt:g} m + 1 m step each")
+        print(f"\n[2] estimators, {args.compare_s:g} s hold at {alt:g} m + "
+              f"{compare_step_m(alt):+g} m step each")
         pc: dict[str, Any] | None = None
         for kind in kinds:
             try:
