@@ -97,6 +97,98 @@ class Core:
         self.collisions = 0  # contacts begun at >= IMPACT_SPEED_MPS
 
 
+class SubStep:
+    """What every sub-step of length `dt` for airframe `prm` shares, worked out once.
+
+    The integrator runs 400 times a simulated second; re-deriving these (the motor lag's
+    exponential, the derived constants, a dozen parameter lookups) on every call was a fifth of
+    its cost. Each value is the very expression `advance` used to evaluate, so results are the
+    same to the last bit.
+    """
+
+    __slots__ = (
+        "alpha",
+        "arm",
+        "avionics_a",
+        "capacity_mah",
+        "cells",
+        "crot",
+        "drag_lin",
+        "drag_quad",
+        "dt",
+        "e",
+        "friction",
+        "gear_m",
+        "half_dt",
+        "half_height_m",
+        "inv_mass",
+        "ixx",
+        "iyy",
+        "izz",
+        "k_thrust",
+        "k_torque",
+        "lin",
+        "motor_eff",
+        "omega_max_ref",
+        "prm",
+        "radius_m",
+        "ref_voltage",
+        "resistance",
+        "x_iyy_izz",
+        "y_izz_ixx",
+        "z_ixx_iyy",
+    )
+
+    def __init__(self, prm: VehicleParams, dt: float) -> None:
+        d = derived(prm)
+        self.prm = prm
+        self.dt = dt
+        self.half_dt = 0.5 * dt
+        self.alpha = 1.0 - math.exp(-dt / prm.motor_lag_s)
+        self.e = prm.thrust_expo
+        self.lin = 1.0 - prm.thrust_expo
+        self.omega_max_ref = d.omega_max_ref_radps
+        self.ref_voltage = prm.ref_voltage_v
+        self.k_thrust = d.k_thrust
+        self.k_torque = d.k_torque
+        self.avionics_a = prm.avionics_current_a
+        self.motor_eff = prm.motor_efficiency
+        self.capacity_mah = prm.battery_capacity_mah
+        self.cells = prm.battery_cells
+        self.resistance = prm.battery_resistance_ohm
+        self.drag_lin = prm.drag_lin_n_per_mps
+        self.drag_quad = prm.drag_quad_n_per_mps2
+        self.inv_mass = d.inv_mass
+        self.friction = prm.ground_friction
+        self.radius_m = prm.body_radius_m
+        self.half_height_m = prm.body_half_height_m
+        self.gear_m = prm.gear_height_m
+        self.arm = d.arm_m
+        self.crot = prm.rot_drag_nm_per_radps
+        self.ixx, self.iyy, self.izz = d.ixx, d.iyy, d.izz
+        self.x_iyy_izz = d.izz - d.iyy  # the gyroscopic terms' inertia differences
+        self.y_izz_ixx = d.ixx - d.izz
+        self.z_ixx_iyy = d.iyy - d.ixx
+
+    def speed_fraction(self, u: float) -> float:
+        """Steady rotor speed at throttle u as a fraction of the maximum (thrust ∝ its square)."""
+        return math.sqrt(self.lin * u + self.e * u * u)
+
+
+_substep_of: dict[tuple[int, float], SubStep] = {}
+
+
+def sub_step(prm: VehicleParams, dt: float) -> SubStep:
+    """The SubStep of (prm, dt), cached by the identity of prm (held, so its id stays)."""
+    k = _substep_of.get((id(prm), dt))
+    if k is not None and k.prm is prm:
+        return k
+    if len(_substep_of) >= 64:
+        _substep_of.clear()
+    k = _substep_of[(id(prm), dt)] = SubStep(prm, dt)
+    return k
+
+
 def advance(
     c: Core,
     u0: float,
@@ -108,33 +200,41 @@ def advance(
     dt: float,
 ) -> None:
     """Advance `c` by one sub-step dt (≤ prm.max_dt_s) with throttles u (0..1, pre-clamped)."""
-    d = derived(prm)
+    k = sub_step(prm, dt)
+    speed = k.speed_fraction
+    advance_at(c, speed(u0), speed(u1), speed(u2), speed(u3), k, geom)
+
+
+def advance_at(
+    c: Core, f0: float, f1: float, f2: float, f3: float, k: SubStep, geom: Geometry
+) -> None:
+    """`advance` with the motors' steady speed fractions (`SubStep.speed_fraction` of the
+    throttles) given: a caller that holds the throttles over several sub-steps works them out
+    once."""
+    dt = k.dt
     # Motors: steady speed from throttle and battery volts, first-order lag (exact discrete).
-    wmax = d.omega_max_ref_radps * c.voltage_v / prm.ref_voltage_v
-    e = prm.thrust_expo
-    lin = 1.0 - e
-    alpha = 1.0 - math.exp(-dt / prm.motor_lag_s)
-    m0 = c.m0 + (wmax * math.sqrt(lin * u0 + e * u0 * u0) - c.m0) * alpha
-    m1 = c.m1 + (wmax * math.sqrt(lin * u1 + e * u1 * u1) - c.m1) * alpha
-    m2 = c.m2 + (wmax * math.sqrt(lin * u2 + e * u2 * u2) - c.m2) * alpha
-    m3 = c.m3 + (wmax * math.sqrt(lin * u3 + e * u3 * u3) - c.m3) * alpha
+    wmax = k.omega_max_ref * c.voltage_v / k.ref_voltage
+    alpha = k.alpha
+    m0 = c.m0 + (wmax * f0 - c.m0) * alpha
+    m1 = c.m1 + (wmax * f1 - c.m1) * alpha
+    m2 = c.m2 + (wmax * f2 - c.m2) * alpha
+    m3 = c.m3 + (wmax * f3 - c.m3) * alpha
     c.m0, c.m1, c.m2, c.m3 = m0, m1, m2, m3
     s0, s1, s2, s3 = m0 * m0, m1 * m1, m2 * m2, m3 * m3
-    kt = d.k_thrust
+    kt = k.k_thrust
     thrust = kt * (s0 + s1 + s2 + s3)
 
     # Battery: shaft power k_m·ω³ over efficiency, at the previous terminal voltage.
-    shaft_w = d.k_torque * (s0 * m0 + s1 * m1 + s2 * m2 + s3 * m3)
+    shaft_w = k.k_torque * (s0 * m0 + s1 * m1 + s2 * m2 + s3 * m3)
     v_prev = c.voltage_v
-    current = prm.avionics_current_a + (
-        shaft_w / (prm.motor_efficiency * v_prev) if v_prev > 0.5 else 0.0
-    )
+    current = k.avionics_a + (shaft_w / (k.motor_eff * v_prev) if v_prev > 0.5 else 0.0)
     used = c.used_mah + current * dt / 3.6
-    soc = 1.0 - used / prm.battery_capacity_mah
-    ocv = prm.battery_cells * cell_ocv_v(soc)
+    soc = 1.0 - used / k.capacity_mah
+    ocv = k.cells * cell_ocv_v(soc)
     c.used_mah = used
     c.current_a = current
-    c.voltage_v = max(ocv - current * prm.battery_resistance_ohm, 0.0)
+    v = ocv - current * k.resistance
+    c.voltage_v = 0.0 if v < 0.0 else v  # max(v, 0.0) without the call, -0.0 and NaN alike
 
     # Forces in NED.
     qw, qx, qy, qz = c.qw, c.qx, c.qy, c.qz
@@ -142,10 +242,10 @@ def advance(
     bzy = 2.0 * (qy * qz - qw * qx)
     bzz = 1.0 - 2.0 * (qx * qx + qy * qy)
     vx, vy, vz = c.vx, c.vy, c.vz
-    drag = prm.drag_lin_n_per_mps + prm.drag_quad_n_per_mps2 * math.sqrt(
+    drag = k.drag_lin + k.drag_quad * math.sqrt(
         vx * vx + vy * vy + vz * vz
     )
-    im = d.inv_mass
+    im = k.inv_mass
     ax = (-thrust * bzx - drag * vx) * im
     ay = (-thrust * bzy - drag * vy) * im
     az = (-thrust * bzz - drag * vz) * im + G
@@ -155,7 +255,7 @@ def advance(
         speed_h = math.sqrt(vx * vx + vy * vy)
         nvx = nvy = 0.0
         if speed_h > 0.0:
-            decel = prm.ground_friction * az * dt
+            decel = k.friction * az * dt
             keep = max(speed_h - decel, 0.0) / speed_h
             nvx, nvy = vx * keep, vy * keep
         c.x += nvx * dt
@@ -165,7 +265,7 @@ def advance(
         c.p = c.q = c.r = 0.0
         c.collided_with = None
         if nvx != 0.0 or nvy != 0.0:
-            hit = geom.cylinder_hit(c.x, c.y, c.z, prm.body_radius_m, prm.body_half_height_m)
+            hit = geom.cylinder_hit(c.x, c.y, c.z, k.radius_m, k.half_height_m)
             if hit is not None:
                 c.x -= nvx * dt
                 c.y -= nvy * dt
@@ -174,22 +274,21 @@ def advance(
                 if speed_h >= IMPACT_SPEED_MPS:
                     c.collisions += 1
             # Slid off the edge of a box top: fall from the next step on.
-            c.on_ground = c.z >= geom.support_z(c.x, c.y, c.z) - prm.gear_height_m - 1e-9
+            c.on_ground = c.z >= geom.support_z(c.x, c.y, c.z) - k.gear_m - 1e-9
         return
 
     # Torques in FRD (see module docstring for the signs).
-    arm = d.arm_m
-    crot = prm.rot_drag_nm_per_radps
+    arm = k.arm
+    crot = k.crot
     p, q, r = c.p, c.q, c.r
     tx = arm * kt * (s3 - s1) - crot * p
     ty = arm * kt * (s0 - s2) - crot * q
-    tz = d.k_torque * (s1 + s3 - s0 - s2) - crot * r
-    ixx, iyy, izz = d.ixx, d.iyy, d.izz
-    p += (tx - q * r * (izz - iyy)) / ixx * dt
-    q += (ty - r * p * (ixx - izz)) / iyy * dt
-    r += (tz - p * q * (iyy - ixx)) / izz * dt
+    tz = k.k_torque * (s1 + s3 - s0 - s2) - crot * r
+    p += (tx - q * r * k.x_iyy_izz) / k.ixx * dt
+    q += (ty - r * p * k.y_izz_ixx) / k.iyy * dt
+    r += (tz - p * q * k.z_ixx_iyy) / k.izz * dt
     c.p, c.q, c.r = p, q, r
-    h = 0.5 * dt
+    h = k.half_dt
     nw = qw - h * (qx * p + qy * q + qz * r)
     nx = qx + h * (qw * p + qy * r - qz * q)
     ny = qy + h * (qw * q + qz * p - qx * r)
@@ -200,7 +299,7 @@ def advance(
     nvx, nvy, nvz = vx + ax * dt, vy + ay * dt, vz + az * dt
     ox, oy, oz = c.x, c.y, c.z
     nx_, ny_, nz_ = ox + nvx * dt, oy + nvy * dt, oz + nvz * dt
-    rest_z = geom.support_z(nx_, ny_, oz) - prm.gear_height_m
+    rest_z = geom.support_z(nx_, ny_, oz) - k.gear_m
     on_ground = nz_ >= rest_z
     if on_ground:
         # Inelastic touchdown: stop on the surface, attitude settles level on the skids.
@@ -210,21 +309,21 @@ def advance(
         c.p = c.q = c.r = 0.0
         yaw = math.atan2(2.0 * (c.qw * c.qz + c.qx * c.qy), 1.0 - 2.0 * (c.qy**2 + c.qz**2))
         c.qw, c.qx, c.qy, c.qz = math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0)
-    hit = geom.cylinder_hit(nx_, ny_, nz_, prm.body_radius_m, prm.body_half_height_m)
+    hit = geom.cylinder_hit(nx_, ny_, nz_, k.radius_m, k.half_height_m)
     if hit is not None and (
-        geom.cylinder_hit(ox, oy, oz, prm.body_radius_m, prm.body_half_height_m) is None
+        geom.cylinder_hit(ox, oy, oz, k.radius_m, k.half_height_m) is None
     ):
         # Stop at the last clear position (no tunnelling) and drop the velocity into the
         # obstacle; motion along its surface goes on, so a vehicle never hangs on a wall.
         nx_, ny_, nz_ = ox, oy, oz
-        cx, cy, cz = geom.contact_normal(hit, (ox, oy, oz), (nx_, ny_, nz_), prm.body_half_height_m)
+        cx, cy, cz = geom.contact_normal(hit, (ox, oy, oz), (nx_, ny_, nz_), k.half_height_m)
         into = nvx * cx + nvy * cy + nvz * cz
         if into < 0.0:
             nvx -= into * cx
             nvy -= into * cy
             nvz -= into * cz
             sx, sy, sz = ox + nvx * dt, oy + nvy * dt, oz + nvz * dt
-            if geom.cylinder_hit(sx, sy, sz, prm.body_radius_m, prm.body_half_height_m) is None:
+            if geom.cylinder_hit(sx, sy, sz, k.radius_m, k.half_height_m) is None:
                 nx_, ny_, nz_ = sx, sy, sz
         on_ground = c.on_ground
     if hit is not None and c.collided_with is None and vx * vx + vy * vy + vz * vz >= IMPACT2:
