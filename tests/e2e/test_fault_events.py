@@ -151,29 +151,36 @@ def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float =
                    [(clock(w), thr) for w, thr in tap.throttle])
 
 
-def _lands_safely(r: Run) -> None:
+def _lands_safely(r: Run, open_rise: str | None = None) -> None:
+    """On the floor and disarmed within 20 s, touchdown ≤ 1 m/s, never above setpoint + 0.3 m.
+    `open_rise`: why the height is a known open fault for this case (an xfail when it is the
+    only thing broken; the rest stays strict)."""
     assert r.event_s is not None, f"the event never happened: exit {r.exit_code} {r.reason!r}"
-    assert r.alt_m.max() <= SETPOINT_M + 0.3, f"rose to {r.alt_m.max():.2f} m"
     down = r.touchdown()
     assert down is not None, "never back on the floor"
     assert down[0] - r.event_s <= 20.0 and down[1] <= 1.0, f"touchdown {down}"
     off = r.disarmed_s()
     assert off is not None and off - r.event_s <= 20.0, f"disarmed at {off} (event {r.event_s})"
+    peak = float(r.alt_m.max())
+    if open_rise is not None and peak > SETPOINT_M + 0.3:
+        pytest.xfail(f"rose to {peak:.2f} m: {open_rise}")
+    assert peak <= SETPOINT_M + 0.3, f"rose to {peak:.2f} m"
 
 
-@pytest.mark.parametrize("profile", [
-    pytest.param("apm25", marks=pytest.mark.xfail(
-        strict=False, reason="a dead station leaves 3.2.1 on its last override for 2 s until the "
-        "radio failsafe; with the hold's ±30 us throttle swing the drift can pass setpoint + "
-        "0.3 m (the open-loop seconds are the firmware's; open fault)")),
-    pytest.param("copter4", marks=pytest.mark.xfail(
-        strict=False, reason="4.x flies the last override until its GCS failsafe (2 s with "
-        "FS_GCS_TIMEOUT 2): the same open-loop drift, up to +0.58 m measured on a loaded "
-        "machine (open fault)"))])
+OPEN_LOOP_AFTER_KILL = {
+    "apm25": "a dead station leaves 3.2.1 on its last override for 2 s until the radio "
+             "failsafe; with the hold's ±30 us throttle swing the drift can pass setpoint + 0.3 m "
+             "(the open-loop seconds are the firmware's; open fault)",
+    "copter4": "4.x flies the last override until its GCS failsafe (2 s with FS_GCS_TIMEOUT 2): "
+               "the same open-loop drift, up to +0.58 m measured on a loaded machine (open fault)",
+}
+
+
+@pytest.mark.parametrize("profile", ["apm25", "copter4"])
 def test_station_sigkilled_mid_air_is_landed_by_the_vehicles_failsafe(profile: str) -> None:
     r = fly(profile, lambda proc, _p, _w: proc.send_signal(signal.SIGKILL))
-    _lands_safely(r)
     assert r.exit_code == -signal.SIGKILL
+    _lands_safely(r, open_rise=OPEN_LOOP_AFTER_KILL[profile])
 
 
 def test_auto_disarm_before_takeoff_is_reported_and_nothing_winds_up() -> None:

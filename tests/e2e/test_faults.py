@@ -38,6 +38,7 @@ MATRIX = [
     FlightSpec("both", "apm25", "serial"),
 ]
 MAX_OVER_SETPOINT_M = 0.3
+ROSE = "rose "  # the start of the problem line for a vehicle above that
 MAX_TOUCHDOWN_MPS = 1.0
 DOWN_AND_DISARMED_S = 20.0
 LOSSY_HOLD_M = 0.1
@@ -66,7 +67,7 @@ def _problems(r: FlightResult) -> list[str]:
         out.append(f"the hold before the fault was already off (RMS {pre} m over 10 s): an "
                    "overloaded machine or a station that cannot hold")
     if not r.max_over_setpoint_m <= MAX_OVER_SETPOINT_M:
-        out.append(f"rose {r.max_over_setpoint_m:.2f} m over the setpoint")
+        out.append(f"{ROSE}{r.max_over_setpoint_m:.2f} m over the setpoint")
     if c.lands:
         down = r.touchdown_s
         if down is None or down - r.fault_start_s > DOWN_AND_DISARMED_S:
@@ -110,25 +111,22 @@ OPEN_LOOP_4X = ("with the uplink dead ArduCopter 4.x flies the last override for
                 "(FS_GCS_TIMEOUT 2, its minimum) until its GCS failsafe lands it; with the hold's "
                 "±30 us throttle swing the drift in those seconds was 0.2-0.5 m on a loaded "
                 "2-core run and can cross setpoint + 0.3 m (measured and reported; open fault)")
+# Each case's one open property (the start of its problem line) and why; everything else the
+# case promises (the landing, its speed, the disarm, the exit code, LAND asked) stays strict.
 KNOWN_OPEN = {
-    "uplink-apm25-tcp": OPEN_LOOP,
-    "both-apm25-tcp": OPEN_LOOP,
-    "uplink-copter4-tcp": OPEN_LOOP_4X,
-    "both-copter4-tcp": OPEN_LOOP_4X,
+    "uplink-apm25-tcp": (ROSE, OPEN_LOOP),
+    "both-apm25-tcp": (ROSE, OPEN_LOOP),
+    "uplink-copter4-tcp": (ROSE, OPEN_LOOP_4X),
+    "both-copter4-tcp": (ROSE, OPEN_LOOP_4X),
     # the same seconds over the 115200-baud line (rose 0.99 m once, from 29 us over the median)
-    "both-apm25-serial": OPEN_LOOP,
-    "lossy-apm25-tcp": ("30 % loss with 5 % bit flips on 3.2.1's 25 Hz telemetry: the estimate "
-                        "drifts and the hold stays within ±0.14-0.17 m, not ±0.1 m (open fault)"),
+    "both-apm25-serial": (ROSE, OPEN_LOOP),
+    "lossy-apm25-tcp": ("held only within", "30 % loss with 5 % bit flips on 3.2.1's 25 Hz "
+                        "telemetry: the estimate drifts and the hold stays within ±0.14-0.17 m, "
+                        "not ±0.1 m (open fault)"),
 }
 
 
-def _param(spec: FlightSpec) -> object:
-    why = KNOWN_OPEN.get(spec.id)
-    marks = [pytest.mark.xfail(strict=False, reason=why)] if why else []
-    return pytest.param(spec, marks=marks, id=spec.id)
-
-
-@pytest.mark.parametrize("spec", [_param(s) for s in MATRIX])
+@pytest.mark.parametrize("spec", [pytest.param(s, id=s.id) for s in MATRIX])
 def test_station_survives_the_fault(
         spec: FlightSpec, flights: dict[FlightSpec, FlightResult | Exception]) -> None:
     r = flights[spec]
@@ -137,4 +135,9 @@ def test_station_survives_the_fault(
     print(r.report())  # the numbers, kept for -rP / the log even when the case passes
     assert CASES[spec.case] is r.case
     problems = _problems(r)
-    assert not problems, "; ".join(problems) + "\n" + r.report()
+    open_start, why = KNOWN_OPEN.get(spec.id, (None, ""))
+    known = [p for p in problems if open_start is not None and p.startswith(open_start)]
+    hard = [p for p in problems if p not in known]
+    assert not hard, "; ".join(problems) + "\n" + r.report()
+    if known:
+        pytest.xfail(f"{'; '.join(known)}: {why}")
