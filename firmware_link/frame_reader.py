@@ -32,15 +32,14 @@ except ImportError:  # pymavlink's own decode checks the CRC instead (slower, sa
 _V1, _V2 = mavlink.PROTOCOL_MARKER_V1, mavlink.PROTOCOL_MARKER_V2
 _SIGNED = mavlink.MAVLINK_IFLAG_SIGNED
 _SIGNATURE_LEN = mavlink.MAVLINK_SIGNATURE_BLOCK_LEN
+_CRC = struct.Struct("<H")
 _H1 = struct.Struct("<BBBBBB")
 _H2 = struct.Struct("<BBBBBBBHB")
 
-# (class, unpack, unpack_from, wire-order field names or, for a message with arrays, each field's
-# name, first value and count; the attributes its constructor sets; crc_extra as one byte, to
-# run the checksum on after the frame's own; payload size)
+# (class, unpack, wire-order field names or, for a message with arrays, each field's name, first
+# value and count; the attributes its constructor sets; crc_extra; payload size)
 _Layout = tuple[str, ...] | tuple[tuple[str, int, int], ...]
-_Plain = tuple[type, Callable[[Any], tuple[Any, ...]], Callable[[Any, int], tuple[Any, ...]],
-               _Layout, bool, dict[str, Any], bytes, int]
+_Plain = tuple[type, Callable[[Any], tuple[Any, ...]], _Layout, bool, dict[str, Any], int, int]
 
 
 def _plain(cls: Any) -> _Plain | None:
@@ -62,8 +61,8 @@ def _plain(cls: Any) -> _Plain | None:
         return None
     if set(attrs) - set(cls.fieldnames) - _BOOKKEEPING:
         return None  # a constructor that does more than store its arguments
-    return (cls, cls.unpacker.unpack, cls.unpacker.unpack_from, layout, arrays, attrs,
-            bytes((int(cls.crc_extra),)), int(cls.unpacker.size))
+    return (cls, cls.unpacker.unpack, layout, arrays, attrs, int(cls.crc_extra),
+            int(cls.unpacker.size))
 
 
 _BOOKKEEPING = frozenset({"_header", "_payload", "_msgbuf", "_crc", "_fieldnames", "_type",
@@ -150,16 +149,16 @@ class FrameReader:
             plain = _PLAIN[msg_id] = None if cls is None else _plain(cls)
         if plain is None:
             return None
-        cls, unpack, unpack_from, layout, arrays, attrs, crc_extra, size = plain
-        end = len(frame) - 2
-        crc = frame[end] | (frame[end + 1] << 8)
-        # the checksum runs on over crc_extra: the same CRC as of the body with it appended
-        if mcrf4xx(crc_extra, mcrf4xx(frame[1:end], 0xFFFF)) != crc:
+        cls, unpack, layout, arrays, attrs, crc_extra, size = plain
+        crc = _CRC.unpack_from(frame, len(frame) - 2)[0]
+        body = frame[1:-2]
+        body.append(crc_extra)
+        if mcrf4xx(bytes(body), 0xFFFF) != crc:
             return None  # decode says why
-        if end - header_len >= size:
-            t = unpack_from(frame, header_len)  # the first `size` bytes of the payload
-        else:  # MAVLink 2 drops trailing zeros; MAVLink 1 has no extensions
-            t = unpack(frame[header_len:end] + bytes(size - (end - header_len)))
+        payload = frame[header_len:-2]
+        if len(payload) < size:  # MAVLink 2 drops trailing zeros; MAVLink 1 has no extensions
+            payload.extend(bytes(size - len(payload)))
+        t = unpack(payload[:size])
         d = attrs.copy()
         if arrays:
             for name, first, count in cast(tuple[tuple[str, int, int], ...], layout):
@@ -169,12 +168,7 @@ class FrameReader:
         d["_msgbuf"] = frame
         d["_payload"] = frame[6:-2]  # sic: decode's offset, whichever the header's length
         d["_crc"] = crc
-        # what MAVLink_header(msg_id, incompat, compat, mlen, seq, src, comp) holds, in its
-        # order, without the Python-level constructor call
-        h = _new(_Header)
-        h.__dict__ = {"mlen": mlen, "seq": seq, "srcSystem": src, "srcComponent": comp,
-                      "msgId": msg_id, "incompat_flags": incompat, "compat_flags": compat}
-        d["_header"] = h
+        d["_header"] = _Header(msg_id, incompat, compat, mlen, seq, src, comp)
         m: Any = _new(cls)
         m.__dict__ = d
         return m
