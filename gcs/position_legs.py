@@ -56,7 +56,8 @@ def _score(samples: list[tuple[float, float, float, float]], t0: float, start_n:
 def fly_legs(profile: str, legs_m: tuple[float, ...], *, seed: int = 1,
              observe_s: float = 8.0, band_m: float = 0.05, alt_m: float = 1.0,
              config: StationConfig | None = None) -> list[LegResult]:
-    """Take off to `alt_m`, then fly each leg north (alternating back and forth) and score it."""
+    """Take off to `alt_m`, then fly each leg, north from the start's south side and south from
+    its north side, and score it."""
     options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
                              fix_failsafe=True)
     results: list[LegResult] = []
@@ -85,8 +86,10 @@ def fly_legs(profile: str, legs_m: tuple[float, ...], *, seed: int = 1,
                     alt_m / 0.5 + 20.0)
         runner.pause(4.0)
         here = n0
-        for k, leg in enumerate(legs_m):
-            target = here + (leg if k % 2 == 0 else -leg)
+        for leg in legs_m:
+            # each leg heads back across the start, so the legs stay inside the room (a 6 m
+            # room's wall stops a vehicle 2.75 m from its centre)
+            target = here + (leg if here <= n0 else -leg)
             samples.clear()
             t0 = st.clock.now_s()
             st.set_position_setpoint(PositionSetpoint(target, e0, yaw0))

@@ -487,7 +487,8 @@ class Supervisor:
             pose = inp.mocap
             fresh = pose is not None and inp.t_s - pose.t_s <= MOCAP_STALE_S
             if fresh and pose is not None:
-                self.position = self.pos_ctrl.update(self.pos_setpoint, pose, inp.dt_s)
+                self.position = self.pos_ctrl.update(self.pos_setpoint, pose, inp.dt_s,
+                                                     (inp.roll_rad, inp.pitch_rad))
                 roll, pitch, yaw = (self.position.roll_us, self.position.pitch_us,
                                     self.position.yaw_us)
             else:
