@@ -35,8 +35,6 @@ from sitl.autopilot.throttle_curve import (
     throttle_copter4,
 )
 
-STICK_DZ_US = 30  # RCn_DZ for roll/pitch
-YAW_DZ_US = 40
 GYRO_CAL_S = 1.0  # boot-time gyro calibration of the attitude estimator
 LAND_PAUSE_S = 4.0  # LAND_WITH_DELAY_MS of both firmwares
 
@@ -102,6 +100,10 @@ class Autopilot:
         self._disarm_delay_s = k(Key.DISARM_DELAY_S)
         self._spool_time_s = k(Key.SPOOL_TIME_S)
         self._spin_arm = min(0.3, max(0.0, k(Key.SPIN_ARM)))
+        # the dead zones the vehicle reports are the ones it applies (3.2.1: 30/30/30/40 µs;
+        # 4.7: 20/20/30/20), so a station that reads them flies the sticks it expects
+        self._dz_us = tuple(max(0, min(400, round(k(key))))
+                            for key in (Key.RC1_DZ, Key.RC2_DZ, Key.RC3_DZ, Key.RC4_DZ))
         self._thr_hover_param = k(Key.THR_HOVER)
         self._thr_min_param = k(Key.THR_MIN)
         self._fs_gcs = GcsFailsafeAction.from_param(k(Key.FS_GCS_ENABLE), apm)
@@ -116,21 +118,23 @@ class Autopilot:
     def _throttle_stick(self) -> float:
         """Throttle channel as control_in, 0..1000, with the bottom dead zone."""
         pwm = self.radio.channel(2)
-        return min(1000.0, max(0.0, (pwm - 1000.0 - STICK_DZ_US) * 1000.0 / (1000.0 - STICK_DZ_US)))
+        dz = self._dz_us[2]
+        return min(1000.0, max(0.0, (pwm - 1000.0 - dz) * 1000.0 / (1000.0 - dz)))
+
+    def _centred(self, ch: int) -> float:
+        """A centred stick past its dead zone, -1..1."""
+        d = self.radio.channel(ch) - 1500
+        dz = self._dz_us[ch]
+        if abs(d) <= dz:
+            return 0.0
+        d -= int(math.copysign(dz, d))
+        return d / (500.0 - dz)
 
     def _angle(self, ch: int) -> float:
-        d = self.radio.channel(ch) - 1500
-        if abs(d) <= STICK_DZ_US:
-            return 0.0
-        d -= int(math.copysign(STICK_DZ_US, d))
-        return d / (500.0 - STICK_DZ_US) * self.gains.angle_max_rad
+        return self._centred(ch) * self.gains.angle_max_rad
 
     def _yaw_rate(self) -> float:
-        d = self.radio.channel(3) - 1500
-        if abs(d) <= YAW_DZ_US:
-            return 0.0
-        d -= int(math.copysign(YAW_DZ_US, d))
-        return d / (500.0 - YAW_DZ_US) * self.gains.pilot_yaw_rate_max_rads
+        return self._centred(3) * self.gains.pilot_yaw_rate_max_rads
 
     def _pilot_climb_cms(self) -> float:
         g = self.gains

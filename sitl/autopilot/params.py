@@ -93,6 +93,10 @@ class Key(enum.Enum):
     DISARM_DELAY_S = enum.auto()
     SPOOL_TIME_S = enum.auto()
     SPIN_ARM = enum.auto()
+    RC1_DZ = enum.auto()  # the sticks' dead zones, µs (roll, pitch, throttle bottom, yaw)
+    RC2_DZ = enum.auto()
+    RC3_DZ = enum.auto()
+    RC4_DZ = enum.auto()
 
 
 @dataclass(frozen=True)
@@ -140,6 +144,7 @@ _APM25_KEYS: dict[Key, tuple[str, float]] = {
     Key.LAND_SPEED: ("LAND_SPEED", 1.0),
     Key.BATT_CAPACITY: ("BATT_CAPACITY", 1.0),
     Key.SPIN_ARM: ("MOT_SPIN_ARMED", 0.001),
+    **{getattr(Key, f"RC{n}_DZ"): (f"RC{n}_DZ", 1.0) for n in (1, 2, 3, 4)},
 }
 
 _COPTER4_KEYS: dict[Key, tuple[str, float]] = {
@@ -178,6 +183,7 @@ _COPTER4_KEYS: dict[Key, tuple[str, float]] = {
     Key.DISARM_DELAY_S: ("DISARM_DELAY", 1.0),
     Key.SPOOL_TIME_S: ("MOT_SPOOL_TIME", 1.0),
     Key.SPIN_ARM: ("MOT_SPIN_ARM", 1.0),
+    **{getattr(Key, f"RC{n}_DZ"): (f"RC{n}_DZ", 1.0) for n in (1, 2, 3, 4)},
 }
 
 # What a meaning reads when the firmware has no parameter for it.

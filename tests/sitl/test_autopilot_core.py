@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from sitl.autopilot import Key, ParamStore, Profile
+from sitl.autopilot.autopilot import Autopilot
 from sitl.autopilot.failsafe import BATT_LOW_TIMER_S, GCS_TIMEOUT_S, BatteryWatch, GcsWatch
 from sitl.autopilot.gains import Gains
 from sitl.autopilot.inertial_nav import InertialNavZ
@@ -168,3 +169,20 @@ def test_param_store_rounds_integer_types_and_tracks_versions() -> None:
     assert "MOT_THST_HOVER" in ParamStore(Profile.COPTER4)
     assert ParamStore(Profile.COPTER4).name_of(Key.POS_Z_P) == "PSC_POSZ_P"
     assert p.name_of(Key.POS_Z_P) == "THR_ALT_P"
+
+
+@pytest.mark.parametrize(("profile", "dz_us"), [(Profile.APM25, 30), (Profile.COPTER4, 20)])
+def test_the_sticks_dead_zones_are_the_ones_the_vehicle_reports(profile: Profile,
+                                                                 dz_us: int) -> None:
+    """3.2.1 reports RC1_DZ/RC2_DZ 30 µs, 4.7 reports 20 (the fixtures' parameter lists) and
+    each applies what it reports; a pilot's change of RC1_DZ takes effect too."""
+    params = ParamStore(profile)
+    ap = Autopilot(profile, params, 0.45)
+    assert params.k(Key.RC1_DZ) == params.k(Key.RC2_DZ) == dz_us
+    ap.radio.apply_override([1500 + dz_us, 1500 - dz_us - 1, 1000, 1500], 0.0)
+    assert ap._angle(0) == 0.0 and ap._angle(1) < 0.0
+    ap.radio.apply_override([1500 + dz_us + 1, 1500, 1000, 1500], 0.0)
+    assert ap._angle(0) > 0.0
+    params.set_key(Key.RC1_DZ, dz_us + 10)
+    ap._refresh_gains()
+    assert ap._angle(0) == 0.0
