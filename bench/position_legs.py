@@ -1,10 +1,10 @@
 """Position legs in lockstep: overshoot and settling of the horizontal hold, per profile.
 
 Takes off to 1 m on the bundled SITL (lockstep: the station's own code on simulated time,
-motion capture for position), then moves the set point by each leg north and south across the start, and prints
-per leg: overshoot past the new spot (% of the leg), time to stay within ±5 cm, the largest
-excursion off the line (east) and of the altitude. Floors from the mission issue: a 0.5 m leg
-within ±5 cm in ≤ 2 s with ≤ 10 % overshoot; a 2 m leg in ≤ 4 s.
+motion capture for position), then moves the set point by each leg north and south across
+the start, and prints per leg: overshoot past the new spot (% of the leg), time to stay within
+±5 cm, the largest excursion off the line (east) and of the altitude. Floors from the mission
+issue: a 0.5 m leg within ±5 cm in ≤ 2 s with ≤ 10 % overshoot; a 2 m leg in ≤ 4 s.
 
     .venv/bin/python bench/position_legs.py [--seeds 1,2,3] [--legs 0.5,2.0]
 """
@@ -29,7 +29,8 @@ def main() -> int:
     args = ap.parse_args()
     seeds = [int(s) for s in args.seeds.split(",")]
     legs = tuple(float(x) for x in args.legs.split(","))
-    print(f"lockstep, seeds {seeds}, legs {legs} m north and south across the start, band ±5 cm, 10 s each")
+    print(f"lockstep, seeds {seeds}, legs {legs} m north and south across the start, "
+          "band ±5 cm, 10 s each")
     print(f"{'profile':8} {'leg m':>5} {'overshoot % med/max':>20} {'settle s med/max':>17} "
           f"{'cross cm':>8} {'alt dev cm':>10}")
     for profile in ("apm25", "copter4"):
