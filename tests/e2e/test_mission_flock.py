@@ -28,9 +28,6 @@ def _states(rec: Recording) -> dict[str, float]:
 
 @pytest.mark.e2e
 @pytest.mark.solo
-@pytest.mark.xfail(strict=False, reason="five wall-clock stations and the SITL at 2x want 1.4 "
-                   "cores: on a 2-core runner one run of seed 3 took 417 s and touched a box 4 "
-                   "times (truth); lockstep, 20 seeds fly with 0 contacts (open)")
 @pytest.mark.timeout(420)
 def test_five_vehicles_fly_the_flock_to_its_goals_at_2x(tmp_path: Path) -> None:
     # a fresh process, as a user runs it: the station's loops share nothing with other tests
