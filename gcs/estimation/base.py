@@ -447,7 +447,7 @@ class AltEstimator(ABC):
         self._reject_seen_s = t_s
         while self._rejected[0][0] < t_s - p.reacquire_window_s:
             self._rejected.popleft()
-        recent = [r for _, r in self._rejected]
+        recent = [r for t, r in self._rejected if t >= t_s - p.reacquire_steady_s]
         if (
             t_s - self._reject_run_start_s >= p.reacquire_min_s
             and len(recent) >= p.reacquire_count
@@ -459,7 +459,32 @@ class AltEstimator(ABC):
             self._rejected.clear()
             self._last_sonar_t_s = t_s
             return SonarStatus.REACQUIRED, innovation
+        on_line = self._rejected_on_a_line(t_s)
+        if on_line is not None:
+            self._reset_alt(on_line)
+            self._rejected.clear()
+            self._last_sonar_t_s = t_s
+            return SonarStatus.REACQUIRED, on_line - alt_pred
         return SonarStatus.REJECTED, innovation
+
+    def _rejected_on_a_line(self, t_s: float) -> float | None:
+        """The altitude now of the rejected readings of the last `reacquire_min_s`, when the
+        run has lasted that long and they lie on one straight line in time; else None."""
+        p = self.params
+        if t_s - self._reject_run_start_s < p.reacquire_min_s:
+            return None
+        pts = [(t, z) for t, z in self._rejected if t >= t_s - p.reacquire_min_s]
+        n = len(pts)
+        if n < p.reacquire_track_count:
+            return None
+        mt = sum(t for t, _ in pts) / n
+        mz = sum(z for _, z in pts) / n
+        stt = sum((t - mt) ** 2 for t, _ in pts)
+        if stt <= 0.0:
+            return None
+        slope = sum((t - mt) * (z - mz) for t, z in pts) / stt
+        rms = math.sqrt(sum((z - mz - slope * (t - mt)) ** 2 for t, z in pts) / n)
+        return mz + slope * (t_s - mt) if rms <= p.reacquire_track_rms_m else None
 
 
 def _copied(v: object) -> object:

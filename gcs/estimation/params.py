@@ -49,6 +49,16 @@ class EstimatorParams:
     reacquire_spread_m: float = 0.1  # max spread of those readings (steady sonar)
     reacquire_window_s: float = 3.0
     reacquire_min_s: float = 1.5  # rejections must last longer than the carpet's late echoes
+    # ...or, over that last stretch, at least this many rejected readings on one straight line
+    # in time (the vehicle climbing or sinking past an estimate that drifted the other way):
+    # a rejected sonar that moves steadily is no carpet's scatter either, and waiting for it
+    # to stand still would wait for ever while the hold chases the drift
+    reacquire_track_count: int = 8
+    # "Reads steadily" is judged on the readings of this last stretch of the run: a run that
+    # began with the vehicle moving (a climb past a drifted estimate, stopped by a table top)
+    # must not keep the steady readings after it from counting
+    reacquire_steady_s: float = 0.75
+    reacquire_track_rms_m: float = 0.02  # the line's residual: the sonar's noise and its cm
     late_gap_s: float = 0.15  # a new reading after a longer silence is a late echo...
     late_max_s: float = 1.4  # ...unless the silence outlasts any echo: then its ping is unknown
     late_sigma_m: float = 0.12  # extra noise of a late echo shifted by the estimated climb
@@ -101,7 +111,7 @@ class EstimatorParams:
             raise ValueError("need 0 <= sonar_min_m < sonar_max_m")
         positive = ("sonar_sigma_m", "accel_sigma_mps2", "gate_sigma", "gate_m",
                     "complementary_tc_s", "max_dt_s", "control_accel_sigma_mps2",
-                    "climb_vel_mps", "climb_leak_s")
+                    "climb_vel_mps", "climb_leak_s", "reacquire_steady_s")
         for name in positive:
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"{name} must be > 0")
@@ -110,5 +120,7 @@ class EstimatorParams:
                      "sonar_doubt_s"):
             if getattr(self, name) < 0.0:
                 raise ValueError(f"{name} must be >= 0")
-        if self.reacquire_count < 2:
-            raise ValueError("reacquire_count must be >= 2")
+        if self.reacquire_count < 2 or self.reacquire_track_count < 3:
+            raise ValueError("reacquire_count must be >= 2 and reacquire_track_count >= 3")
+        if self.reacquire_track_rms_m < 0.0:
+            raise ValueError("reacquire_track_rms_m must be >= 0")
