@@ -12,6 +12,7 @@ import pytest
 from firmware_link.records import Attitude, Imu, Rangefinder
 from gcs.estimation import (
     GRAVITY_MPS2,
+    AltEstimate,
     ComplementaryEstimator,
     DeadReckoningEstimator,
     EstimatorParams,
@@ -469,29 +470,35 @@ def test_past_a_table_edge_the_barometer_holds_the_estimate_until_it_rebases() -
     assert max(worst) < 0.15
 
 
+def _fly_with_a_spike(prof: Profile, spike_t: float, seconds: float, seed: int
+                      ) -> list[tuple[float, float, AltEstimate]]:
+    """(t, truth, estimate) of a Kalman flight whose accelerometer reads 30 m/s² too low once
+    (a garbled sample, an impact): 0.75 m/s of velocity the vehicle never had."""
+    est = KalmanEstimator()
+    rng = np.random.default_rng(seed)
+    recs: list[tuple[float, float, AltEstimate]] = []
+    for k in range(int(seconds / DT)):
+        t = k * DT
+        h, a = prof(t)
+        if k == int(spike_t / DT):
+            a -= 30.0
+        f = body_specific_force(a + 0.15 + rng.normal(0, 0.3), 0.0, 0.0)
+        imu = Imu(t_s=t, sysid=1, acc_b=f, gyro_b=(0, 0, 0), source="RAW_IMU")
+        att = Attitude(t, 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        sonar = None
+        if k % 2 == 0:
+            sonar = Rangefinder(t, 1, h + rng.normal(0, 0.01), True, "RANGEFINDER")
+        recs.append((t, h, est.update(imu, sonar, att, t)))
+    return recs
+
+
 def test_a_steady_sonar_after_a_climb_the_estimate_lost_is_reacquired() -> None:
     """Under a table: the estimate drifts down (here: one garbled accelerometer sample as the
     vehicle starts to climb), the hold climbs after it, the table top stops the vehicle. The
     sonar is rejected all the while; once it reads steadily, the estimate must come back
     (EPBHA's table mission, lockstep seed 7, ran away to -0.87 m with the vehicle at 0.68 m).
     The readings of the climb that began the run must not keep the steady ones from counting."""
-    prof = smooth_step(10.0, 0.45, 0.68, 0.6)
-    est = KalmanEstimator()
-    rng = np.random.default_rng(7)
-    recs = []
-    for k in range(int(14.0 / DT)):
-        t = k * DT
-        h, a = prof(t)
-        if k == int(10.1 / DT):
-            a -= 30.0  # a spike: 0.75 m/s of velocity the vehicle never had
-        f = body_specific_force(a + 0.15 + rng.normal(0, 0.3), 0.0, 0.0)
-        imu = Imu(t_s=t, sysid=1, acc_b=f, gyro_b=(0, 0, 0), source="RAW_IMU")
-        att = Attitude(t, 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        sonar = None
-        if k % 2 == 0:
-            d = h + rng.normal(0, 0.01)
-            sonar = Rangefinder(t, 1, d, True, "RANGEFINDER")
-        recs.append((t, h, est.update(imu, sonar, att, t)))
+    recs = _fly_with_a_spike(smooth_step(10.0, 0.45, 0.68, 0.6), 10.1, 14.0, seed=7)
     rejected = [t for t, _, r in recs if r.sonar_status is SonarStatus.REJECTED]
     assert rejected and rejected[0] < 10.7  # the run began in the climb
     back = [t for t, _, r in recs if t > 10.1 and r.sonar_status is SonarStatus.REACQUIRED]
@@ -505,21 +512,7 @@ def test_a_rejected_sonar_moving_on_a_straight_line_is_reacquired() -> None:
     def prof(t: float) -> tuple[float, float]:
         return (0.5 + 0.25 * max(0.0, t - 10.0), 0.0) if t < 16.0 else (2.0, 0.0)
 
-    est = KalmanEstimator()
-    rng = np.random.default_rng(3)
-    recs = []
-    for k in range(int(15.0 / DT)):
-        t = k * DT
-        h, a = prof(t)
-        if k == int(11.0 / DT):
-            a -= 30.0
-        f = body_specific_force(a + 0.15 + rng.normal(0, 0.3), 0.0, 0.0)
-        imu = Imu(t_s=t, sysid=1, acc_b=f, gyro_b=(0, 0, 0), source="RAW_IMU")
-        att = Attitude(t, 1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        sonar = None
-        if k % 2 == 0:
-            sonar = Rangefinder(t, 1, h + rng.normal(0, 0.01), True, "RANGEFINDER")
-        recs.append((t, h, est.update(imu, sonar, att, t)))
+    recs = _fly_with_a_spike(prof, 11.0, 15.0, seed=3)
     back = [t for t, _, r in recs if t > 11.0 and r.sonar_status is SonarStatus.REACQUIRED]
     assert back and back[0] < 13.0, back
     assert all(abs(r.alt_m - h) < 0.1 for t, h, r in recs if t > 13.5)
