@@ -480,8 +480,7 @@ class Supervisor:
                            "lost: LAND")
             self.requested_mode, self._asked_why = FlightMode.LAND, "asked: no rise at full climb"
             self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
-        s = self.sticks
-        roll, pitch, yaw = s.roll_us, s.pitch_us, s.yaw_us
+        roll, pitch, yaw = self.sticks.roll_us, self.sticks.pitch_us, self.sticks.yaw_us
         self.position = None
         if self.pos_setpoint is not None:
             pose = inp.mocap
