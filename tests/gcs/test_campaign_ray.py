@@ -11,9 +11,9 @@ from typing import Any
 
 import pytest
 
-pytest.importorskip("ray")
-pytest.importorskip("optuna")
-pytest.importorskip("pyarrow")
+pytest.importorskip("ray", reason="the [campaign] extra is not installed")
+pytest.importorskip("optuna", reason="the [campaign] extra is not installed")
+pytest.importorskip("pyarrow", reason="the [campaign] extra is not installed")
 
 from gcs.campaign import (
     BEST_NAME,
