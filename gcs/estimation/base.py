@@ -447,32 +447,30 @@ class AltEstimator(ABC):
         self._reject_seen_s = t_s
         while self._rejected[0][0] < t_s - p.reacquire_window_s:
             self._rejected.popleft()
-        recent = [r for t, r in self._rejected if t >= t_s - p.reacquire_steady_s]
-        if (
-            t_s - self._reject_run_start_s >= p.reacquire_min_s
-            and len(recent) >= p.reacquire_count
-            and max(recent) - min(recent) <= p.reacquire_spread_m
-        ):
-            # the sonar has disagreed for longer than any late echo lasts and now reads steadily
-            # (a box under the vehicle, or the estimate drifted while coasting): believe it
-            self._reset_alt(z_now)
-            self._rejected.clear()
-            self._last_sonar_t_s = t_s
-            return SonarStatus.REACQUIRED, innovation
-        on_line = self._rejected_on_a_line(t_s)
-        if on_line is not None:
-            self._reset_alt(on_line)
-            self._rejected.clear()
-            self._last_sonar_t_s = t_s
-            return SonarStatus.REACQUIRED, on_line - alt_pred
-        return SonarStatus.REJECTED, innovation
+        believed = self._reacquired_at(t_s, z_now)
+        if believed is None:
+            return SonarStatus.REJECTED, innovation
+        self._reset_alt(believed)
+        self._rejected.clear()
+        self._last_sonar_t_s = t_s
+        return SonarStatus.REACQUIRED, believed - alt_pred
 
-    def _rejected_on_a_line(self, t_s: float) -> float | None:
-        """The altitude now of the rejected readings of the last `reacquire_min_s`, when the
-        run has lasted that long and they lie on one straight line in time; else None."""
+    def _reacquired_at(self, t_s: float, z_now: float) -> float | None:
+        """The altitude to reset to when the sonar has disagreed for longer than any late echo
+        lasts and now tells one story (a box under the vehicle, or an estimate that drifted
+        while coasting): it reads steadily (`z_now`), or moves on a straight line; else None."""
         p = self.params
         if t_s - self._reject_run_start_s < p.reacquire_min_s:
             return None
+        recent = [r for t, r in self._rejected if t >= t_s - p.reacquire_steady_s]
+        if len(recent) >= p.reacquire_count and max(recent) - min(recent) <= p.reacquire_spread_m:
+            return z_now
+        return self._rejected_on_a_line(t_s)
+
+    def _rejected_on_a_line(self, t_s: float) -> float | None:
+        """The altitude now of the rejected readings of the last `reacquire_min_s`, when they
+        lie on one straight line in time; else None."""
+        p = self.params
         pts = [(t, z) for t, z in self._rejected if t >= t_s - p.reacquire_min_s]
         n = len(pts)
         if n < p.reacquire_track_count:

@@ -49,15 +49,16 @@ class EstimatorParams:
     reacquire_spread_m: float = 0.1  # max spread of those readings (steady sonar)
     reacquire_window_s: float = 3.0
     reacquire_min_s: float = 1.5  # rejections must last longer than the carpet's late echoes
-    # ...or, over that last stretch, at least this many rejected readings on one straight line
-    # in time (the vehicle climbing or sinking past an estimate that drifted the other way):
-    # a rejected sonar that moves steadily is no carpet's scatter either, and waiting for it
-    # to stand still would wait for ever while the hold chases the drift
-    reacquire_track_count: int = 8
     # "Reads steadily" is judged on the readings of this last stretch of the run: a run that
     # began with the vehicle moving (a climb past a drifted estimate, stopped by a table top)
     # must not keep the steady readings after it from counting
     reacquire_steady_s: float = 0.75
+    # A run that has lasted reacquire_min_s is believed too when at least this many of its
+    # readings of that last reacquire_min_s lie on one straight line in time (the vehicle
+    # climbing or sinking past an estimate that drifted the other way):
+    # a rejected sonar that moves steadily is no carpet's scatter either, and waiting for it
+    # to stand still would wait for ever while the hold chases the drift
+    reacquire_track_count: int = 8
     reacquire_track_rms_m: float = 0.02  # the line's residual: the sonar's noise and its cm
     late_gap_s: float = 0.15  # a new reading after a longer silence is a late echo...
     late_max_s: float = 1.4  # ...unless the silence outlasts any echo: then its ping is unknown
