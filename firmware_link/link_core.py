@@ -162,6 +162,19 @@ class LinkCore(TransportUpkeep):
         """A snapshot of the counters."""
         return self._ep.snapshot(self._clock())
 
+    def handoff(self) -> tuple[int, tuple | None] | None:
+        """The open transport's descriptor and (UDP) peer, for a process that must be able to
+        take the link over (`gcs.guardian`); None while there is none (being reopened)."""
+        transport = self._ep.transport
+        if transport is None:
+            return None
+        return transport.fileno(), getattr(transport, "peer", None)
+
+    @property
+    def target_component(self) -> int:
+        """The vehicle's autopilot component."""
+        return self._target_component
+
     @property
     def pending_override(self) -> tuple[int, ...] | None:
         """Channels 1–8 of the override waiting in the send slot (None when it went out)."""

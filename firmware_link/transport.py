@@ -236,6 +236,11 @@ class UdpTransport:
         return len(data)
 
     @property
+    def peer(self) -> tuple | None:
+        """Where datagrams go: udpout's fixed address, udpin's last speaker (None before)."""
+        return self._peer
+
+    @property
     def has_peer(self) -> bool:
         """False on udpin until the vehicle has spoken: nowhere to send yet."""
         return self._peer is not None
@@ -346,6 +351,79 @@ class SerialTransport:
     def close(self) -> None:
         """Close the device."""
         self._port.close()
+
+
+class FdTransport:
+    """A serial line taken over as a bare descriptor (another process opened and set it up):
+    non-blocking reads and writes on the descriptor itself."""
+
+    def __init__(self, spec: ConnectionSpec, fd: int) -> None:
+        self.spec = spec
+        self._fd = fd
+        os.set_blocking(fd, False)
+
+    def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes:
+        """Bytes waiting, up to `max_bytes`; raises TransportClosed on hang-up."""
+        # a line set up for non-blocking reads (VMIN 0, VTIME 0, as pyserial's timeout=0)
+        # reads 0 bytes when nothing waits: only a readable one that reads 0 has hung up
+        if not select.select([self._fd], [], [], 0)[0]:
+            return b""
+        try:
+            data = os.read(self._fd, max_bytes)
+        except BlockingIOError:
+            return b""
+        except OSError as exc:
+            raise TransportClosed(f"{self.spec.url}: {exc.strerror or exc}") from None
+        if not data:
+            raise TransportClosed(f"{self.spec.url}: serial device closed")
+        return data
+
+    def write(self, data: bytes | memoryview) -> int:
+        """Bytes of `data` the device took now (0 when its buffer is full)."""
+        try:
+            return os.write(self._fd, data)
+        except OSError as exc:
+            if exc.errno in _WOULD_BLOCK:
+                return 0
+            raise TransportClosed(f"{self.spec.url}: serial write failed: {exc}") from None
+
+    @property
+    def has_peer(self) -> bool:
+        """A serial line always has its far end."""
+        return True
+
+    def wait_readable(self, timeout_s: float) -> None:
+        """Block until bytes arrive or `timeout_s` passes."""
+        _wait(self._fd, timeout_s)
+
+    def wait_writable(self, timeout_s: float) -> None:
+        """Block until the device takes bytes again or `timeout_s` passes."""
+        _wait_out(self._fd, timeout_s)
+
+    def fileno(self) -> int:
+        """The descriptor."""
+        return self._fd
+
+    def close(self) -> None:
+        """Close the descriptor."""
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
+
+
+def adopt_transport(spec: ConnectionSpec, fd: int, peer: tuple | None) -> ByteTransport:
+    """A transport around `fd`, a descriptor of an open link of `spec`'s kind handed over by
+    another process (`peer`: where a UDP link sends). Takes ownership of `fd`."""
+    if spec.transport is Transport.TCP:
+        return TcpTransport._ready(spec, socket.socket(fileno=fd))
+    if spec.transport is Transport.SERIAL:
+        return FdTransport(spec, fd)
+    if spec.transport in (Transport.UDPIN, Transport.UDPOUT):
+        sock = socket.socket(fileno=fd)
+        sock.setblocking(False)
+        return UdpTransport(spec, sock, peer)
+    os.close(fd)
+    raise LinkError(f"{spec.url}: a {spec.transport.value} link cannot be handed over")
 
 
 def open_transport(spec: ConnectionSpec, connect_timeout_s: float = 1.0) -> ByteTransport:

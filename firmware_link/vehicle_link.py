@@ -24,10 +24,10 @@ from typing import Any
 
 from firmware_link.arming import ArmingAndModes, MavResult, clamp_pwm_us
 from firmware_link.bring_up import StreamBringUp
-from firmware_link.connection import parse_connection_string
+from firmware_link.connection import ConnectionSpec, parse_connection_string
 from firmware_link.dialect import MAVLINK1_CANNOT_SIGN
 from firmware_link.errors import LinkError, LinkUsageError
-from firmware_link.firmware import decide_firmware
+from firmware_link.firmware import FirmwareInfo, decide_firmware
 from firmware_link.forward import ForwardPort
 from firmware_link.frames import FrameEndpoint, RawTap
 from firmware_link.identify import Identification
@@ -36,7 +36,7 @@ from firmware_link.params import ParamProtocol
 from firmware_link.protocol import WireVersion
 from firmware_link.records import LinkEventKind
 from firmware_link.signing import KEY_BYTES, signing_timestamp
-from firmware_link.transport import TransportClosed, open_transport
+from firmware_link.transport import ByteTransport, TransportClosed, open_transport
 
 SIGNING_ON = "MAVLink 2 signing on: outgoing frames signed, unsigned frames refused"
 CLOSE_FLUSH_S = 0.5  # close() gives the override release this long to get out
@@ -108,6 +108,37 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
             link._drop_transport()
             link._closed = True
             raise
+        return link
+
+    @classmethod
+    def adopt(
+        cls,
+        spec: ConnectionSpec,
+        transport: ByteTransport,
+        firmware: FirmwareInfo,
+        *,
+        target_system: int,
+        target_component: int,
+        source_system: int = 255,
+        source_component: int = 190,
+        signing_key: bytes | None = None,
+    ) -> VehicleLink:
+        """A link over a transport another process opened and identified (its vehicle, its
+        firmware): no handshake, ready to send. Signed links sign from the present wall time,
+        past anything the first owner sent."""
+        endpoint = FrameEndpoint(transport, source_system=source_system,
+                                 source_component=source_component, clock=time.monotonic)
+        link = cls(spec, endpoint, clock=time.monotonic, wall_clock=time.time,
+                   signing_key=signing_key)
+        link._target_system = target_system
+        link._target_component = target_component
+        link._firmware = firmware
+        endpoint.wire = firmware.wire
+        link._last_rx_s = time.monotonic()  # heard by the first owner: not lost yet
+        if signing_key is not None:
+            endpoint.set_signing(signing_key, link_id=0,
+                                 timestamp=signing_timestamp(time.time()))
+            link._signing = True
         return link
 
     def _await_vehicle(self, target_system: int | None, wait_s: float, install_key: bool) -> None:

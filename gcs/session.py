@@ -31,6 +31,7 @@ from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import StationConfig, load_config
 from gcs.errors import UsageError
 from gcs.foxglove_feed import DEFAULT_WORLD, FoxgloveFeed, open_live, world_boxes
+from gcs.guardian import Guardian, GuardianSetup
 from gcs.parallel_open import open_in_parallel
 from gcs.position_controller import STICK_PARAMS, with_vehicle_sticks
 from gcs.preflight import PreflightReport, read_and_check
@@ -280,6 +281,14 @@ class StationSession:
             mocap = MocapFor(mocap_link, sysid)
         station = Station(link, config=config, curve=curve, mocap=mocap, recorder=sink,
                           clock=self.clock)
+        guardian = Guardian.start(link, GuardianSetup(
+            link.spec, link.firmware, link.target_system, link.target_component, key,
+            config.period_s, getattr(self.clock, "speedup", 1.0)))
+        if guardian is not None:
+            station.add_listener(guardian.on_snapshot)
+            # after the station's own landing and letting go, before the link closes: a
+            # TCP link ends only when the guardian's copy of it is closed too
+            stack.callback(guardian.stand_down)
         report = self._preflight(link)
         self.preflight[sysid] = report
         station.preflight(report.ok, report.summary())

@@ -47,7 +47,7 @@ from gcs.config import StationConfig
 from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
 from gcs.loop import FixedRateLoop
 from gcs.position_controller import PositionController
-from gcs.station_exit import emergency_land, let_go
+from gcs.station_exit import LAND_ON_DEATH, emergency_land, let_go
 from gcs.station_intents import STICK_MAX_US, STICK_MIN_US, StationIntents
 from gcs.station_record import TickRecord, record_tick
 from gcs.station_types import (
@@ -283,12 +283,10 @@ class Station(StationIntents):
     def _emergency_land(self) -> None:
         """The loop crashed: ask for LAND (the supervisor's safe throttle, level) until a
         heartbeat shows it."""
-        if self.supervisor.state not in AIRBORNE_CAPABLE:
+        if self.supervisor.state not in LAND_ON_DEATH:
             return
-        est = self._estimate
-        throttle = (self.supervisor.safe_throttle_us(est.alt_m) if est is not None
-                    else STICK_MIN_US)
-        hb = emergency_land(self.link, throttle, self.config.period_s)
+        hb = emergency_land(self.link, self._snapshot.safe_throttle_us,
+                            self.config.period_s, speedup=getattr(self.clock, "speedup", 1.0))
         if isinstance(hb, Heartbeat):
             self._latest[Heartbeat] = hb
         elif hb:
@@ -494,4 +492,6 @@ class Station(StationIntents):
             events=tuple(self._events),
             listener_errors=self._listener_errors,
             link_down_s=self._link_down_s,
+            safe_throttle_us=(sup.safe_throttle_us(self._estimate.alt_m)
+                              if self._estimate is not None else STICK_MIN_US),
         )

@@ -8,9 +8,13 @@ from typing import Any
 
 from firmware_link.records import FlightMode, Heartbeat, RcCommand
 from gcs.supervisor import SupervisorState
+from gcs.supervisor.types import AIRBORNE_CAPABLE
 
 EMERGENCY_LAND_S = 3.0
 MODE_RESEND_S = 0.5
+LAND_ON_DEATH = AIRBORNE_CAPABLE | {SupervisorState.LINK_LOST}
+"""States in which a station that dies (its loop, or its whole process: `gcs.guardian`) has
+the vehicle asked for LAND: it may be armed and in the air, and the station was flying it."""
 
 
 def let_go(link: Any, state: SupervisorState, hb: Heartbeat | None) -> str:
@@ -32,12 +36,14 @@ def let_go(link: Any, state: SupervisorState, hb: Heartbeat | None) -> str:
 
 
 def emergency_land(link: Any, throttle_us: int, period_s: float,
-                   seconds: float = EMERGENCY_LAND_S) -> Heartbeat | str | None:
+                   seconds: float = EMERGENCY_LAND_S,
+                   speedup: float = 1.0) -> Heartbeat | str | None:
     """SET_MODE LAND every half second with `throttle_us` (the supervisor's safe throttle:
     hover aloft, minimum on the floor), level, until a heartbeat shows LAND or disarmed
-    (returned), the time is up (None) or the link fails (its error text)."""
+    (returned), the time is up (None) or the link fails (its error text). Times are the
+    vehicle's: a SITL run `speedup` times faster gets them that much sooner."""
     command = RcCommand(1500, 1500, throttle_us, 1500)
-    end = time.monotonic() + seconds
+    end = time.monotonic() + seconds / speedup
     next_mode = 0.0
     try:
         while time.monotonic() < end:
@@ -46,9 +52,9 @@ def emergency_land(link: Any, throttle_us: int, period_s: float,
                     return r
             if time.monotonic() >= next_mode:
                 link.send_set_mode(FlightMode.LAND)
-                next_mode = time.monotonic() + MODE_RESEND_S
+                next_mode = time.monotonic() + MODE_RESEND_S / speedup
             link.rc_override(command)
-            time.sleep(period_s)  # a dead loop paces itself: there is no clock to wait on
+            time.sleep(period_s / speedup)  # a dead loop paces itself: there is no clock to wait on
     except Exception as exc:
         return str(exc) or type(exc).__name__
     return None

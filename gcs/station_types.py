@@ -88,6 +88,7 @@ class StationSnapshot:
     events: tuple[StationEvent, ...]
     listener_errors: int = 0
     link_down_s: float = 0.0  # total time the link has been lost so far
+    safe_throttle_us: int = 1000  # what a dead station leaves it on: hover aloft, minimum down
 
 
 @dataclass(frozen=True, slots=True)

@@ -4,7 +4,8 @@ The station is the real CLI through the fault proxy (so a fault can be added and
 that reached the vehicle is seen); height comes from motion capture, the vehicle's arming and
 mode from a listen-only UDP endpoint of the SITL. Cases:
 
-- the station is SIGKILLed mid-air: the vehicle's own failsafe (set up before the flight) lands it;
+- the station is SIGKILLed mid-air (over TCP, and over the serial pty): its guardian process
+  takes the link over and lands the vehicle;
 - the vehicle auto-disarms on the floor before take-off: fly says so (exit 3), nothing winds up;
 - the pilot's kill switch (SIGQUIT) during a link loss, each way: throttle minimum from the next
   tick, disarmed within a second of the uplink working.
@@ -79,12 +80,13 @@ Trigger = Callable[[subprocess.Popen[str], FaultProxy, MavWatcher], None]
 
 
 @contextlib.contextmanager
-def _rig(profile: str, speedup: float,
+def _rig(profile: str, speedup: float, transport: str = "tcp",
          ) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy, StationTap]]:
     udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     udp.bind(("127.0.0.1", 0))
     args = ["--tcp", "0", "--profile", profile, "--speedup", f"{speedup:g}", "--seed", "4",
-            "--udp", f"127.0.0.1:{udp.getsockname()[1]}"]
+            "--udp", f"127.0.0.1:{udp.getsockname()[1]}",
+            *(["--serial"] if transport == "serial" else [])]
     with contextlib.ExitStack() as stack:
         sitl = stack.enter_context(_sitl(args))
         watch_udp = MavWatcher(udp, udp=True)
@@ -94,19 +96,26 @@ def _rig(profile: str, speedup: float,
         watch_mocap = MavWatcher(socket.create_connection((host, int(port)), 5.0), udp=False)
         stack.callback(watch_mocap.close)
         tap = StationTap()
-        h, p = sitl.endpoint(1, "tcp").rsplit(":", 1)
-        proxy = FaultProxy(target=(h, int(p)), seed=4, time_scale=speedup, tap=tap).start()
+        if transport == "serial":  # the station on a pseudo-terminal at 115200 baud
+            proxy = FaultProxy(serial_port=sitl.endpoint(1, "serial"), seed=4,
+                               time_scale=speedup, tap=tap).start()
+            sitl.connect = f"{proxy.address},115200"
+        else:
+            h, p = sitl.endpoint(1, "tcp").rsplit(":", 1)
+            proxy = FaultProxy(target=(h, int(p)), seed=4, time_scale=speedup, tap=tap).start()
+            sitl.connect = proxy.address
         stack.callback(proxy.stop)
         sitl.mocap_url = mocap_url
         yield sitl, watch_udp, watch_mocap, proxy, tap
 
 
 def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float = 3.0,
-        extra: tuple[str, ...] = (), watch_s: float = 25.0, speedup: float = SPEEDUP) -> Run:
+        extra: tuple[str, ...] = (), watch_s: float = 25.0, speedup: float = SPEEDUP,
+        transport: str = "tcp") -> Run:
     """Fly 1 m; `after_s` simulated seconds into `phase` (seen on --live) call `trigger`; keep
     watching for `watch_s` simulated seconds after it."""
-    with _rig(profile, speedup) as (sitl, watch_udp, watch_mocap, proxy, tap):
-        argv = [sys.executable, "-m", "gcs", "fly", "--connect", proxy.address, "--mocap",
+    with _rig(profile, speedup, transport) as (sitl, watch_udp, watch_mocap, proxy, tap):
+        argv = [sys.executable, "-m", "gcs", "fly", "--connect", sitl.connect, "--mocap",
                 sitl.mocap_url, "--profile", profile, "--alt", f"{SETPOINT_M}", "--hold", "20",
                 "--json", "--live", "--no-record", "--speedup", f"{speedup:g}", "--fix-failsafe",
                 *extra]
@@ -151,40 +160,30 @@ def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float =
                    [(clock(w), thr) for w, thr in tap.throttle])
 
 
-def _lands_safely(r: Run, open_loop: str | None = None) -> None:
-    """On the floor and disarmed within 20 s, touchdown ≤ 1 m/s, never above setpoint + 0.3 m.
-    `open_loop`: why the firmware flies the last override blind for a while in this case, so
-    that the drift in those seconds (up past setpoint + 0.3 m, or down into the floor faster
-    than 1 m/s) is a known open fault: an xfail when it is the only thing broken."""
+def _lands_safely(r: Run) -> None:
+    """On the floor and disarmed within 20 s, touchdown ≤ 1 m/s, never above setpoint + 0.3 m."""
     assert r.event_s is not None, f"the event never happened: exit {r.exit_code} {r.reason!r}"
     down = r.touchdown()
     assert down is not None, "never back on the floor"
     assert down[0] - r.event_s <= 20.0, f"touchdown {down}"
+    assert down[1] <= 1.0, f"touched down at {down[1]:.2f} m/s"
     off = r.disarmed_s()
     assert off is not None and off - r.event_s <= 20.0, f"disarmed at {off} (event {r.event_s})"
-    peak = float(r.alt_m.max())
-    drift = [f"rose to {peak:.2f} m"] if peak > SETPOINT_M + 0.3 else []
-    drift += [f"touched down at {down[1]:.2f} m/s"] if down[1] > 1.0 else []
-    if open_loop is not None and drift:
-        pytest.xfail(f"{'; '.join(drift)} ({down[0] - r.event_s:.1f} s after): {open_loop}")
-    assert not drift, "; ".join(drift)
+    assert float(r.alt_m.max()) <= SETPOINT_M + 0.3, f"rose to {float(r.alt_m.max()):.2f} m"
 
 
-OPEN_LOOP_AFTER_KILL = {
-    "apm25": "a dead station leaves 3.2.1 on its last override for 2 s until the radio "
-             "failsafe; with the hold's ±30 us throttle swing the drift can pass setpoint + 0.3 m "
-             "or reach the floor (the open-loop seconds are the firmware's; open fault)",
-    "copter4": "4.x flies the last override until its GCS failsafe (2 s with FS_GCS_TIMEOUT 2): "
-               "the same open-loop drift, up to +0.68 m, or down to the floor at 1.02 m/s, "
-               "measured on a loaded machine (open fault)",
-}
-
-
-@pytest.mark.parametrize("profile", ["apm25", "copter4"])
-def test_station_sigkilled_mid_air_is_landed_by_the_vehicles_failsafe(profile: str) -> None:
-    r = fly(profile, lambda proc, _p, _w: proc.send_signal(signal.SIGKILL))
+@pytest.mark.parametrize(("profile", "transport"),
+                         [("apm25", "tcp"), ("copter4", "tcp"), ("apm25", "serial")])
+def test_station_sigkilled_mid_air_is_landed_by_its_guardian(profile: str,
+                                                             transport: str) -> None:
+    """Without its guardian (gcs/guardian.py) the vehicle flew the last override blind until
+    its failsafe: up to 1.86 m from a 1 m hold, or into the floor at 1.02 m/s."""
+    r = fly(profile, lambda proc, _p, _w: proc.send_signal(signal.SIGKILL),
+            transport=transport, speedup=SPEEDUP if transport == "tcp" else 2.0)
     assert r.exit_code == -signal.SIGKILL
-    _lands_safely(r, open_loop=OPEN_LOOP_AFTER_KILL[profile])
+    assert "guardian: the station stopped with vehicle 1 in hold: asking for LAND" in r.stderr
+    assert "guardian: vehicle 1 in LAND, overrides released" in r.stderr, r.stderr[-500:]
+    _lands_safely(r)
 
 
 def test_auto_disarm_before_takeoff_is_reported_and_nothing_winds_up() -> None:
