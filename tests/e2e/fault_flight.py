@@ -177,6 +177,9 @@ def _run_fly(argv: list[str], proxy: FaultProxy, case: FaultCase,
                     w = proxy.schedule(case.direction, FAULT_AFTER_HOLD_S, case.duration_s,
                                        drop=case.drop, loss=case.loss, bitflip=case.bitflip)
                     out["fault_wall"] = proxy.monotonic_at(w.start_s)
+                    if case.kill:
+                        threading.Timer(max(0.0, out["fault_wall"] - time.monotonic()),
+                                        proc.kill).start()
 
     readers = [threading.Thread(target=read_stdout, daemon=True),
                threading.Thread(target=lambda: stderr_lines.extend(proc.stderr or []),

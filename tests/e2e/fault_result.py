@@ -31,11 +31,12 @@ class FaultCase:
     loss: float = 0.0
     bitflip: float = 0.0
     documented: str = ""
+    kill: bool = False  # the fault is the station's process killed (SIGKILL), not the link's
 
     @property
     def lands(self) -> bool:
-        """A lost link must end in a landing; a lossy one must keep flying."""
-        return self.drop
+        """A lost link or a killed station must end in a landing; a lossy link keeps flying."""
+        return self.drop or self.kill
 
 
 CASES: dict[str, FaultCase] = {c.name: c for c in (
@@ -47,6 +48,9 @@ CASES: dict[str, FaultCase] = {c.name: c for c in (
               documented="LAND requests lost; vehicle's failsafe lands it"),
     FaultCase("lossy", Direction.BOTH, 60.0, False, loss=0.3, bitflip=0.05,
               documented="30 % loss + 5 % flips: any frame is proof of life; keeps holding"),
+    # the window only marks the moment (nothing dropped): the station is SIGKILLed then
+    FaultCase("sigkill", Direction.BOTH, 0.01, False, kill=True,
+              documented="station process killed: its guardian takes the link, lands it"),
 )}
 
 
