@@ -343,7 +343,9 @@ class Autopilot:
         t_roll = self._angle(0)
         t_pitch = self._angle(1)
         yaw_rate = self._yaw_rate()
-        if st.hold_for_gcs:
+        # LAND without GPS takes no pilot input under a radio failsafe (land_nogps_run: `if
+        # (!failsafe.radio)`): a dead uplink's last override must not keep the vehicle leaning
+        if st.hold_for_gcs or (st.mode is FlightMode.LAND and st.radio_failsafe):
             t_roll = t_pitch = yaw_rate = 0.0
         if st.mode is FlightMode.STABILIZE:
             stick = self._throttle_stick()

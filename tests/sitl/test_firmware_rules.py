@@ -274,6 +274,26 @@ def test_apm25_radio_failsafe_lands_2_s_after_the_last_override_overrides_stay()
     assert truth_alt(gcs) < 0.1
 
 
+def test_apm25_radio_failsafe_land_levels_whatever_the_last_override_leant() -> None:
+    """land_nogps_run takes no pilot roll, pitch or yaw under a radio failsafe: the dead
+    uplink's last override, still on the radio, must not keep the vehicle leaning (it once
+    carried a landing vehicle into a wall and down a 0.45 m drop)."""
+    _sim, gcs = make(Profile.APM25)
+    pilot = Pilot(gcs)
+    take_off(gcs, pilot, 1.2)
+    pilot.sticks[2] = HOVER_STICK_US
+    pilot.fly(1.0)
+    pilot.sticks[0] = 1600  # a lean to the right, as a position hold might ask
+    pilot.fly(0.5)
+    assert gcs.of_type("ATTITUDE")[-1].roll > 0.05
+    pilot.overrides = False
+    pilot.fly(3.5)
+    assert _hb(gcs)[0] == 9  # the radio failsafe's LAND
+    msgs = pilot.fly(1.0)
+    assert gcs.of_type("RC_CHANNELS_RAW", msgs)[-1].chan1_raw == 1600  # still on the radio
+    assert abs(gcs.of_type("ATTITUDE", msgs)[-1].roll) < 0.02
+
+
 def test_apm25_overrides_without_failsafes_never_expire() -> None:
     _sim, gcs = make(Profile.APM25)
     _set(gcs, "FS_THR_ENABLE", 0.0)
