@@ -1,0 +1,101 @@
+"""The firmware's open-loop seconds over many seeds: a radio fade in lockstep, what it does.
+
+Flies `quadgcs fly` (1.0 m, 45 s hold) in lockstep on the bundled SITL with a fade of the
+vehicle's link from t = 40 s (simulated, a little over 30 s into the hold) for 15 s: the uplink
+only, or both ways. With the uplink dead the autopilot flies the last override until its own
+failsafe (3.2.1: radio failsafe 2 s after the last override; 4.x: GCS failsafe after
+FS_GCS_TIMEOUT 2 s), then lands. Heights are the SITL's truth; the SITL runs on 25 s after the
+station has given up, so the landing is seen.
+
+Prints per profile and fade: the peak height (median, worst, flights above setpoint + 0.3 m)
+and the touchdown speed (median, worst, flights over 1.0 m/s: the slope of the last 0.25 s
+above the floor), and the flights that never came down.
+
+    .venv/bin/python bench/open_loop.py [--seeds 1-20] [--fade up,both]
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import statistics
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from gcs.commands.fly import fly_session
+from gcs.errors import FlightFailed
+from gcs.flight import FlightPlan
+from gcs.lockstep_session import LockstepSession
+from gcs.session import SessionOptions
+
+FADE_START_S = 40.0
+FADE_S = 15.0
+SETPOINT_M = 1.0
+AFTER_S = 25.0
+FLOOR_BAND_M = 0.03
+
+
+def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None]:
+    """(peak height above the floor after the fade began, touchdown speed or None)."""
+    options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
+                             fix_failsafe=True)
+    faults = {"fade": fade, "fade_start_s": FADE_START_S, "fade_s": FADE_S}
+    session = LockstepSession(options, faults=faults)
+    with session:
+        vehicle = session.first
+        # the flight fails when the vehicle leaves the station's control: what follows is the
+        # point
+        with contextlib.suppress(FlightFailed):
+            fly_session(session, FlightPlan(alt_m=SETPOINT_M, hold_s=45.0), pilot_signals=False)
+        end = session.clock.now_s() + AFTER_S
+        while session.clock.now_s() < end and vehicle.truth is not None:
+            session.sitl.sitl.advance_to(session.clock.now_s() + 0.5)
+            vehicle.truth.reports()  # takes what arrived (nothing pumps it once fly is over)
+        series = vehicle.truth_series()
+    assert series is not None, "lockstep flies with the truth endpoint"
+    t, alt = series.t_s, series.alt_m
+    floor = float(alt[: max(1, min(50, alt.size))].min())
+    after = t >= FADE_START_S
+    peak = float(alt[after].max() - floor)
+    down = np.nonzero(after & (alt <= floor + FLOOR_BAND_M))[0]
+    if not down.size:
+        return peak, None
+    t_c = t[down[0]]
+    sel = (t >= t_c - 0.25) & (t <= t_c)
+    return peak, float(max(0.0, -np.polyfit(t[sel] - t_c, alt[sel], 1)[0]))
+
+
+def _seeds(text: str) -> list[int]:
+    first, _, last = text.partition("-")
+    return list(range(int(first), int(last or first) + 1))
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", default="1-20", help="SITL seeds, FIRST-LAST (default 1-20)")
+    ap.add_argument("--fade", default="up,both", help="fades: up, both, down (comma-separated)")
+    args = ap.parse_args()
+    seeds = _seeds(args.seeds)
+    print(f"lockstep, 1.0 m hold, {FADE_S:g} s fade from t = {FADE_START_S:g} s, seeds "
+          f"{seeds[0]}-{seeds[-1]}, truth heights")
+    print(f"{'profile':8} {'fade':5} {'peak m med/max':>15} {'> +0.3 m':>8} "
+          f"{'touch m/s med/max':>18} {'> 1 m/s':>7} {'not down':>8}")
+    for profile in ("apm25", "copter4"):
+        for fade in args.fade.split(","):
+            runs = [fly_fade(profile, fade, s) for s in seeds]
+            peaks = [p for p, _ in runs]
+            speeds = [v for _, v in runs if v is not None]
+            high = sum(p > SETPOINT_M + 0.3 for p in peaks)
+            fast = sum(v > 1.0 for v in speeds)
+            touch = (f"{statistics.median(speeds):.2f} / {max(speeds):.2f}" if speeds else "-")
+            print(f"{profile:8} {fade:5} {statistics.median(peaks):7.2f} / {max(peaks):4.2f} "
+                  f"{high:8d} {touch:>18} {fast:7d} {len(runs) - len(speeds):8d}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
