@@ -61,7 +61,23 @@ def _wait_out(fd: int, timeout_s: float) -> None:
         select.select([], [fd], [], max(0.0, timeout_s))
 
 
-class TcpTransport:
+class _Descriptor:
+    """Waiting on a transport's descriptor (`fileno()`; a negative one is closed: no wait)."""
+
+    def fileno(self) -> int:
+        """The descriptor (-1 once closed)."""
+        raise NotImplementedError
+
+    def wait_readable(self, timeout_s: float) -> None:
+        """Block until bytes arrive or `timeout_s` passes."""
+        _wait(self.fileno(), timeout_s)
+
+    def wait_writable(self, timeout_s: float) -> None:
+        """Block until the transport takes bytes again or `timeout_s` passes."""
+        _wait_out(self.fileno(), timeout_s)
+
+
+class TcpTransport(_Descriptor):
     """A TCP client socket; reads never block."""
 
     def __init__(self, spec: ConnectionSpec, sock: socket.socket) -> None:
@@ -155,14 +171,6 @@ class TcpTransport:
         """A connected socket always has its peer."""
         return True
 
-    def wait_readable(self, timeout_s: float) -> None:
-        """Block until bytes arrive or `timeout_s` passes."""
-        _wait(self.fileno(), timeout_s)
-
-    def wait_writable(self, timeout_s: float) -> None:
-        """Block until the socket takes bytes again or `timeout_s` passes."""
-        _wait_out(self.fileno(), timeout_s)
-
     def fileno(self) -> int:
         """The socket's descriptor."""
         return self._sock.fileno()
@@ -172,7 +180,7 @@ class TcpTransport:
         self._sock.close()
 
 
-class UdpTransport:
+class UdpTransport(_Descriptor):
     """UDP: `udpin` listens and answers whoever spoke last; `udpout` sends to a fixed peer."""
 
     def __init__(self, spec: ConnectionSpec, sock: socket.socket, peer: tuple | None) -> None:
@@ -245,14 +253,6 @@ class UdpTransport:
         """False on udpin until the vehicle has spoken: nowhere to send yet."""
         return self._peer is not None
 
-    def wait_readable(self, timeout_s: float) -> None:
-        """Block until a datagram arrives or `timeout_s` passes."""
-        _wait(self.fileno(), timeout_s)
-
-    def wait_writable(self, timeout_s: float) -> None:
-        """Block until the socket takes a datagram or `timeout_s` passes."""
-        _wait_out(self.fileno(), timeout_s)
-
     def fileno(self) -> int:
         """The socket's descriptor."""
         return self._sock.fileno()
@@ -262,7 +262,37 @@ class UdpTransport:
         self._sock.close()
 
 
-class SerialTransport:
+class _SerialLine(_Descriptor):
+    """What a serial line does the same however it was opened: writes and waits on its
+    descriptor (`fileno()`, -1 once closed)."""
+
+    spec: ConnectionSpec
+
+    def write(self, data: bytes | memoryview) -> int:
+        """Bytes of `data` the device took now (0 when its buffer is full).
+
+        pyserial opens the device non-blocking, but its `write()` with a zero write timeout
+        spins on EAGAIN; writing the descriptor directly returns instead.
+        """
+        fd = self.fileno()
+        if fd < 0:
+            raise TransportClosed(f"{self.spec.url}: serial device closed")
+        try:
+            return os.write(fd, data)
+        except BlockingIOError:
+            return 0
+        except OSError as exc:
+            if exc.errno in _WOULD_BLOCK:
+                return 0
+            raise TransportClosed(f"{self.spec.url}: serial write failed: {exc}") from None
+
+    @property
+    def has_peer(self) -> bool:
+        """A serial line always has its far end (whether anyone listens is the watchdog's)."""
+        return True
+
+
+class SerialTransport(_SerialLine):
     """A serial device (or pseudo-terminal) through pyserial, opened exclusively."""
 
     def __init__(self, spec: ConnectionSpec, port: serial.Serial) -> None:
@@ -310,37 +340,6 @@ class SerialTransport:
         except (serial.SerialException, OSError) as exc:
             raise TransportClosed(f"{self.spec.url}: serial device lost: {exc}") from None
 
-    def write(self, data: bytes | memoryview) -> int:
-        """Bytes of `data` the device took now (0 when its buffer is full).
-
-        pyserial opens the device non-blocking, but its `write()` with a zero write timeout
-        spins on EAGAIN; writing the descriptor directly returns instead.
-        """
-        fd = self.fileno()
-        if fd < 0:
-            raise TransportClosed(f"{self.spec.url}: serial device closed")
-        try:
-            return os.write(fd, data)
-        except BlockingIOError:
-            return 0
-        except OSError as exc:
-            if exc.errno in _WOULD_BLOCK:
-                return 0
-            raise TransportClosed(f"{self.spec.url}: serial write failed: {exc}") from None
-
-    @property
-    def has_peer(self) -> bool:
-        """A serial line always has its far end (whether anyone listens is the watchdog's)."""
-        return True
-
-    def wait_readable(self, timeout_s: float) -> None:
-        """Block until bytes arrive or `timeout_s` passes."""
-        _wait(self.fileno(), timeout_s)
-
-    def wait_writable(self, timeout_s: float) -> None:
-        """Block until the device takes bytes again or `timeout_s` passes."""
-        _wait_out(self.fileno(), timeout_s)
-
     def fileno(self) -> int:
         """The device's descriptor (-1 once closed)."""
         try:
@@ -353,7 +352,7 @@ class SerialTransport:
         self._port.close()
 
 
-class FdTransport:
+class FdTransport(_SerialLine):
     """A serial line taken over as a bare descriptor (another process opened and set it up):
     non-blocking reads and writes on the descriptor itself."""
 
@@ -377,28 +376,6 @@ class FdTransport:
         if not data:
             raise TransportClosed(f"{self.spec.url}: serial device closed")
         return data
-
-    def write(self, data: bytes | memoryview) -> int:
-        """Bytes of `data` the device took now (0 when its buffer is full)."""
-        try:
-            return os.write(self._fd, data)
-        except OSError as exc:
-            if exc.errno in _WOULD_BLOCK:
-                return 0
-            raise TransportClosed(f"{self.spec.url}: serial write failed: {exc}") from None
-
-    @property
-    def has_peer(self) -> bool:
-        """A serial line always has its far end."""
-        return True
-
-    def wait_readable(self, timeout_s: float) -> None:
-        """Block until bytes arrive or `timeout_s` passes."""
-        _wait(self._fd, timeout_s)
-
-    def wait_writable(self, timeout_s: float) -> None:
-        """Block until the device takes bytes again or `timeout_s` passes."""
-        _wait_out(self._fd, timeout_s)
 
     def fileno(self) -> int:
         """The descriptor."""
