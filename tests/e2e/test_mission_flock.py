@@ -15,6 +15,7 @@ from gcs.mission.events import EVENT
 from logs import Recording, open_recording
 
 MISSION = Path(__file__).resolve().parents[2] / "missions" / "flock_table.toml"
+HEARTBEAT_S = 1.0  # the vehicle's HEARTBEAT period
 AUTO_DISARM_S = 15.0  # ArduCopter 3.2.1 (the mission's profile) on the floor at minimum throttle
 
 
@@ -58,8 +59,12 @@ def test_five_vehicles_fly_the_flock_to_its_goals_at_2x(tmp_path: Path) -> None:
         assert rec.counts["/gcs/rc_override"] > 2000 and rec.counts["/vehicle/heartbeat"] > 50
         assert rec.counts["/mavlink/rx"] > 10_000 and rec.counts["/mavlink/tx"] > 1000
         assert rec.counts["/gcs/tick"] > 2000
-    # armed within a second of each other, off the floor together
-    assert max(armed) - min(armed) < 1.0 and max(took_off) - min(took_off) < 1.0
+    # armed and off the floor together: within one heartbeat of each other. A station sees its
+    # vehicle armed only in the 1 Hz HEARTBEAT, and five stations' ARMs, sent on five loops'
+    # own ticks, can fall either side of one (a fresh-clone CI run: 0.02 s apart for three
+    # vehicles, a heartbeat later for two)
+    assert max(armed) - min(armed) < HEARTBEAT_S + 0.5, armed
+    assert max(took_off) - min(took_off) < HEARTBEAT_S + 0.5, took_off
     team = open_recording(d["recording"])
     steps = [m for _, _, m in team.messages([topics.STEP_FLOCK])]
     assert len(steps) == d["steps"] + 1 and team.counts[topics.SUMMARY] == 1
