@@ -81,14 +81,19 @@ class Guardian:
         in-memory lockstep link)."""
         if setup.spec.transport not in HANDED_OVER:
             return None
-        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         try:
-            proc = subprocess.Popen(
-                [sys.executable, "-m", "gcs.guardian", str(theirs.fileno())],
-                pass_fds=(theirs.fileno(),), stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL, start_new_session=True)
-        finally:
-            theirs.close()
+            ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+            try:
+                proc = subprocess.Popen(
+                    [sys.executable, "-m", "gcs.guardian", str(theirs.fileno())],
+                    pass_fds=(theirs.fileno(),), stdin=subprocess.DEVNULL,
+                    stdout=subprocess.DEVNULL, start_new_session=True)
+            finally:
+                theirs.close()
+        except OSError as exc:  # the station flies as it did before there was a guardian
+            _say(f"not started ({exc}): a station killed mid-air leaves the vehicle to its "
+                 "own failsafe")
+            return None
         ours.sendall(pickle.dumps(("setup", setup)))
         ours.setblocking(False)  # from here on the loop thread sends: it must never wait
         guardian = cls(link, ours, proc)

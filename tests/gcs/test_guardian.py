@@ -150,3 +150,20 @@ def test_a_reopened_link_is_handed_over_again() -> None:
         guardian.stand_down()
         link.close()
         v.stop()
+
+
+def test_a_guardian_that_cannot_start_is_one_line_and_no_guardian(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    v = FakeVehicle("apm25").start()
+    link = VehicleLink.open(v.url, identify=False)
+    try:
+        monkeypatch.setattr("sys.executable", "/nonexistent/python3")
+        guardian = Guardian.start(link, GuardianSetup(link.spec, link.firmware, 1, 1, None,
+                                                      0.025, 1.0))
+        assert guardian is None
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("guardian: not started (")
+        assert "own failsafe" in err[0]
+    finally:
+        link.close()
+        v.stop()
