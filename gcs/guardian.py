@@ -81,6 +81,7 @@ class Guardian:
         in-memory lockstep link)."""
         if setup.spec.transport not in HANDED_OVER:
             return None
+        ours: socket.socket | None = None
         try:
             ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
             try:
@@ -91,6 +92,8 @@ class Guardian:
             finally:
                 theirs.close()
         except OSError as exc:  # the station flies as it did before there was a guardian
+            if ours is not None:
+                ours.close()
             _say(f"not started ({exc}): a station killed mid-air leaves the vehicle to its "
                  "own failsafe")
             return None
