@@ -38,7 +38,8 @@ G = 9.80665
 @pytest.fixture(scope="module")
 def records_by_type() -> dict[type, list]:
     if not FIXTURE.exists():
-        pytest.skip("fixture tlog not present")
+        pytest.skip(f"the real flight log {FIXTURE} is not here "
+                    "(it comes with ../shared/fixtures)")
     conn = mavutil.mavlink_connection(str(FIXTURE), dialect="ardupilotmega")
     converter = RecordConverter()
     out: dict[type, list] = defaultdict(list)

@@ -18,7 +18,8 @@ ANCHOR_NS = 1_795_000_000_000_000_000
 def flight_tlog() -> Path:
     """The real ArduCopter 4.7 SITL flight log."""
     if not FLIGHT_TLOG.exists():
-        pytest.skip(f"fixture {FLIGHT_TLOG} not present")
+        pytest.skip(f"the real 4.7 flight log {FLIGHT_TLOG} is not here "
+                    "(it comes with ../shared/fixtures)")
     return FLIGHT_TLOG
 
 

@@ -22,7 +22,8 @@ from tests.fixture_paths import FOXGLOVE_SCHEMAS
 def require_schemas() -> Path:
     """The schema folder, or skip the test when the fixtures are not beside the checkout."""
     if not (FOXGLOVE_SCHEMAS / "SceneUpdate.json").is_file():
-        pytest.skip(f"fixture {FOXGLOVE_SCHEMAS} not present")
+        pytest.skip(f"Foxglove's schemas {FOXGLOVE_SCHEMAS} are not here "
+                    "(they come with ../shared/fixtures)")
     return FOXGLOVE_SCHEMAS
 
 

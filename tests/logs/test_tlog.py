@@ -41,7 +41,8 @@ def round_trip(tmp_path_factory) -> tuple[Path, Path, Path]:
     from tests.logs.conftest import FLIGHT_TLOG
 
     if not FLIGHT_TLOG.exists():
-        pytest.skip("fixture tlog not present")
+        pytest.skip(f"the real 4.7 flight log {FLIGHT_TLOG} is not here "
+                    "(it comes with ../shared/fixtures)")
     d = tmp_path_factory.mktemp("tlog")
     mcap = d / "imported.mcap"
     out = d / "exported.tlog"

@@ -36,7 +36,9 @@ def _streamed(profile: str) -> list[mavlink.MAVLink_message]:
     return [m for m in parser.parse_buffer(bytes(data)) or [] if m.get_type() != "BAD_DATA"]
 
 
-@pytest.mark.skipif(not FramePacker.available(), reason="no fast CRC routine installed")
+@pytest.mark.skipif(not FramePacker.available(),
+                    reason="fastcrc (the packer's CRC) is not installed: the SITL packs "
+                    "with pymavlink")
 @pytest.mark.parametrize("profile", ["apm25", "copter4"])
 def test_every_frame_is_what_pymavlink_packs(profile: str) -> None:
     msgs = _streamed(profile)
