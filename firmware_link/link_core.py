@@ -162,13 +162,14 @@ class LinkCore(TransportUpkeep):
         """A snapshot of the counters."""
         return self._ep.snapshot(self._clock())
 
-    def handoff(self) -> tuple[int, tuple | None] | None:
-        """The open transport's descriptor and (UDP) peer, for a process that must be able to
-        take the link over (`gcs.guardian`); None while there is none (being reopened)."""
+    def handoff(self) -> tuple[int, int, tuple | None] | None:
+        """(transport generation, descriptor, UDP peer) of the open transport, for a process
+        that must be able to take the link over (`gcs.guardian`); None while there is none
+        (being reopened). A new generation is a new transport, whatever its descriptor."""
         transport = self._ep.transport
         if transport is None:
             return None
-        return transport.fileno(), getattr(transport, "peer", None)
+        return self._transport_generation, transport.fileno(), getattr(transport, "peer", None)
 
     @property
     def target_component(self) -> int:

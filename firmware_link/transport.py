@@ -15,6 +15,7 @@ import errno
 import os
 import select
 import socket
+from collections.abc import Callable
 from typing import Protocol
 
 import serial
@@ -64,9 +65,7 @@ def _wait_out(fd: int, timeout_s: float) -> None:
 class _Descriptor:
     """Waiting on a transport's descriptor (`fileno()`; a negative one is closed: no wait)."""
 
-    def fileno(self) -> int:
-        """The descriptor (-1 once closed)."""
-        raise NotImplementedError
+    fileno: Callable[[], int]  # each transport's own: its socket's, its device's
 
     def wait_readable(self, timeout_s: float) -> None:
         """Block until bytes arrive or `timeout_s` passes."""

@@ -35,9 +35,11 @@ class TransportUpkeep:
         self._reconnect_try = 0
         self._connecting: socket.socket | None = None
         self._connect_started_s = 0.0
+        self._transport_generation = 0  # one more for every transport dropped
 
     def _drop_transport(self) -> None:
         transport, self._ep.transport = self._ep.transport, None
+        self._transport_generation += 1
         # What waited for that transport is lost with it; a reopened link starts clean
         # rather than sending stale commands.
         self._ep.discard_queue()

@@ -140,11 +140,11 @@ class Guardian:
             if self._sent_link is not None and self._send(("link", None)):
                 self._sent_link = self._sent_peer = None
             return
-        fd, peer = handoff
-        # by inode, not number: a reopened link may get the number of the one it replaces
-        ident = os.fstat(fd).st_ino
-        if (ident, peer) != (self._sent_link, self._sent_peer) and self._send(("link", peer), fd):
-            self._sent_link, self._sent_peer = ident, peer
+        generation, fd, peer = handoff
+        # by generation, not number: a reopened link may get the number of the one it replaced
+        if ((generation, peer) != (self._sent_link, self._sent_peer)
+                and self._send(("link", peer), fd)):
+            self._sent_link, self._sent_peer = generation, peer
 
     def _send(self, message: tuple, fd: int | None = None) -> bool:
         data = pickle.dumps(message)

@@ -7,6 +7,7 @@ close it the same way (the kernel does nothing more when the process is killed).
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Iterator
 from types import SimpleNamespace
@@ -28,17 +29,15 @@ def _snapshot(state: SupervisorState, throttle_us: int = HOVER_US) -> SimpleName
     return SimpleNamespace(state=state, safe_throttle_us=throttle_us)
 
 
-@pytest.fixture(params=[("apm25", False, None), ("copter4", False, None),
-                        ("copter4", False, KEY), ("apm25", True, None)],
-                ids=["apm25-tcp", "copter4-tcp", "copter4-tcp-signed", "apm25-serial"])
-def flying(request: pytest.FixtureRequest) -> Iterator[tuple[FakeVehicle, VehicleLink, Guardian]]:
-    """An armed vehicle in STABILIZE, its link, and the link's guardian."""
-    profile, serial, key = request.param
+@contextlib.contextmanager
+def _guarded(profile: str, *, serial: bool = False, key: bytes | None = None,
+             speedup: float = 1.0) -> Iterator[tuple[FakeVehicle, VehicleLink, Guardian]]:
+    """An armed vehicle in STABILIZE, the station's link to it, and the link's guardian."""
     v = FakeVehicle(profile, serial=serial, signing_key=key).start()
     link = VehicleLink.open(v.url, signing_key=key, identify=False)
     v.state.armed, v.state.mode = True, int(FlightMode.STABILIZE)
     guardian = Guardian.start(link, GuardianSetup(link.spec, link.firmware, link.target_system,
-                                                  link.target_component, key, 0.025, 1.0))
+                                                  link.target_component, key, 0.025, speedup))
     assert guardian is not None
     try:
         yield v, link, guardian
@@ -46,6 +45,16 @@ def flying(request: pytest.FixtureRequest) -> Iterator[tuple[FakeVehicle, Vehicl
         guardian.stand_down()
         link.close()
         v.stop()
+
+
+@pytest.fixture(params=[("apm25", False, None), ("copter4", False, None),
+                        ("copter4", False, KEY), ("apm25", True, None)],
+                ids=["apm25-tcp", "copter4-tcp", "copter4-tcp-signed", "apm25-serial"])
+def flying(request: pytest.FixtureRequest) -> Iterator[tuple[FakeVehicle, VehicleLink, Guardian]]:
+    """An armed vehicle in STABILIZE, its link, and the link's guardian."""
+    profile, serial, key = request.param
+    with _guarded(profile, serial=serial, key=key) as rig:
+        yield rig
 
 
 def _die(guardian: Guardian) -> int:
@@ -93,13 +102,8 @@ def test_a_station_that_dies_not_flying_the_vehicle_adds_nothing(flying, state) 
 @pytest.mark.parametrize("profile", ["apm25", "copter4"])
 def test_a_vehicle_that_never_answers_is_left_to_its_failsafe(profile: str) -> None:
     """(At 3x: the guardian's 3 s are the vehicle's, here a SITL's three times faster.)"""
-    v = FakeVehicle(profile).start()
-    link = VehicleLink.open(v.url, identify=False)
-    v.state.armed, v.state.heartbeats = True, False
-    guardian = Guardian.start(link, GuardianSetup(link.spec, link.firmware, 1, 1, None,
-                                                  0.025, 3.0))
-    assert guardian is not None
-    try:
+    with _guarded(profile, speedup=3.0) as (v, _link, guardian):
+        v.state.heartbeats = False
         guardian.on_snapshot(_snapshot(SupervisorState.HOLD))
         t0 = time.monotonic()
         assert _die(guardian) == 1  # LAND asked for 3 s, never shown: it goes silent
@@ -107,10 +111,6 @@ def test_a_vehicle_that_never_answers_is_left_to_its_failsafe(profile: str) -> N
         assert v.state.mode == int(FlightMode.LAND)  # asked all the same
         last = v.state.overrides[-1][2]
         assert last[2] == HOVER_US  # not released: 4.x would drop to the radio's minimum
-    finally:
-        guardian.stand_down()
-        link.close()
-        v.stop()
 
 
 def _restarted(v: FakeVehicle) -> bool:
@@ -124,12 +124,7 @@ def _restarted(v: FakeVehicle) -> bool:
 def test_a_reopened_link_is_handed_over_again() -> None:
     """The station's TCP link reconnects (the vehicle end restarted): the guardian must hold the
     new connection, not the dead one, though the descriptor may have the same number."""
-    v = FakeVehicle("copter4").start()
-    link = VehicleLink.open(v.url, identify=False)
-    guardian = Guardian.start(link, GuardianSetup(link.spec, link.firmware, 1, 1, None,
-                                                  0.025, 1.0))
-    assert guardian is not None
-    try:
+    with _guarded("copter4") as (v, link, guardian):
         guardian.on_snapshot(_snapshot(SupervisorState.HOLD))
         v.crash()
         assert wait_until(lambda: any(
@@ -146,10 +141,6 @@ def test_a_reopened_link_is_handed_over_again() -> None:
         guardian.on_snapshot(_snapshot(SupervisorState.HOLD))
         assert _die(guardian) == 0
         assert v.state.mode == int(FlightMode.LAND)
-    finally:
-        guardian.stand_down()
-        link.close()
-        v.stop()
 
 
 def test_a_guardian_that_cannot_start_is_one_line_and_no_guardian(
