@@ -11,6 +11,7 @@ lossy radio while telemetry flows says nothing about the link; silence does.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections import deque
@@ -28,6 +29,7 @@ from firmware_link.records import (
     Heartbeat,
     LinkEvent,
     LinkEventKind,
+    Rangefinder,
     StatusText,
     TelemetryRecord,
 )
@@ -230,6 +232,8 @@ class LinkCore(TransportUpkeep):
         elif kind == "AUTOPILOT_VERSION" and from_autopilot:
             self._evidence.autopilot_version(msg)
         for record in self._convert.convert(msg, now):
+            if isinstance(record, Rangefinder):
+                record = dataclasses.replace(record, link_lost=self._ep.tally.lost_messages)
             if isinstance(record, Heartbeat) and record.compid == self._target_component:
                 self._on_vehicle_heartbeat(record, now)
             elif isinstance(record, StatusText):

@@ -120,6 +120,9 @@ class Rangefinder:
     distance_m: float
     valid: bool
     source: str  # "RANGEFINDER" or "DISTANCE_SENSOR"
+    # the link's lost frames (sequence gaps, every sender) when this one arrived: whether the
+    # stream between two readings arrived whole, which a sonar's silence can only be told by
+    link_lost: int = 0
 
 
 @dataclass(frozen=True, slots=True)

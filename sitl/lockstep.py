@@ -16,6 +16,7 @@ than `PORT_BACKLOG_BYTES` behind loses what does not fit.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,21 +50,32 @@ class LinkFaults:
 
     `fade` loses every byte of one way ("down": vehicle to station, "up", or "both") from
     `fade_start_s` for `fade_s` simulated seconds, a radio fade; `loss` loses each whole frame
-    with that probability both ways, from the port's own seeded generator."""
+    with that probability both ways, from the port's own seeded generator, from `loss_start_s`
+    for `loss_s` seconds (by default from power-on, for ever). A frame with a flipped bit is a
+    lost frame to its reader (the checksum fails), so the fault proxy's loss and flips are one
+    `loss` here."""
 
     loss: float = 0.0
     fade: str = "none"
     fade_start_s: float = 0.0
     fade_s: float = 0.0
     seed: int = 0
+    loss_start_s: float = 0.0
+    loss_s: float = math.inf
 
     def __post_init__(self) -> None:
         if self.fade not in FADES:
             raise ValueError(f"fade {self.fade!r}: expected one of {', '.join(FADES)}")
         if not 0.0 <= self.loss < 1.0:
             raise ValueError(f"loss {self.loss}: expected a probability in [0, 1)")
-        if self.fade_s < 0.0 or self.fade_start_s < 0.0:
-            raise ValueError("fade_start_s and fade_s: expected seconds >= 0")
+        if min(self.fade_s, self.fade_start_s, self.loss_s, self.loss_start_s) < 0.0:
+            raise ValueError("fade_start_s, fade_s, loss_start_s and loss_s: expected seconds "
+                             ">= 0")
+
+    def lossy(self, t_s: float) -> bool:
+        """Whether frames are being lost at `t_s`."""
+        return (self.loss > 0.0
+                and self.loss_start_s <= t_s < self.loss_start_s + self.loss_s)
 
     def faded(self, way: str, t_s: float) -> bool:
         """Whether way "down" or "up" is in its fade at `t_s`."""
@@ -87,7 +99,7 @@ class _Lossy:
         if f.faded(self.way, t_s):
             self.lost_frames += sum(ok for ok, _ in self._split.feed(data))
             return b""
-        if f.loss <= 0.0:
+        if not f.lossy(t_s):
             return data
         out = bytearray()
         for ok, chunk in self._split.feed(data):

@@ -17,8 +17,9 @@ from gcs.estimation.control import (
     control_predict,
     control_start,
 )
-from gcs.estimation.inputs import sonar_altitude_m, vertical_accel_up_mps2
+from gcs.estimation.inputs import line_at, sonar_altitude_m, vertical_accel_up_mps2
 from gcs.estimation.params import EstimatorParams
+from gcs.estimation.repeat_motion import RepeatMotion
 
 
 class SonarStatus(enum.Enum):
@@ -85,11 +86,11 @@ class AltEstimator(ABC):
         self._last_distance: float | None = None
         self._last_new_t_s = -math.inf  # tick of the last reading counted as new
         self._last_new_rx_s = -math.inf  # its message's receive stamp
-        # How far the vehicle has moved since the altitude the current sonar value measured, by
-        # the accelerometer alone from the velocity then: the sonar's own repeats must not pin
-        # the estimate that judges them (a stale value fused as new holds the filter still).
-        self._repeat_move_m = 0.0
-        self._repeat_vel_mps = 0.0
+        self._lost_at_new = 0  # the link's lost frames at the last new reading
+        # How far the vehicle has moved since the altitude the current sonar value measured:
+        # the sonar's own repeats must not pin the estimate that judges them (a stale value
+        # fused as new holds the filter still)
+        self._repeat_motion = RepeatMotion()
         # the accelerometer's own climb rate, leaking away (see climb_vel_mps)
         self._climb_vel_mps = 0.0
         self._value_rx_s = -math.inf  # when the current value first arrived
@@ -152,11 +153,10 @@ class AltEstimator(ABC):
         if dt > 0.0:
             self._predict(self._acc_up, dt)
             a = self._acc_up - self._state()[2]
-            self._repeat_move_m += (self._repeat_vel_mps + 0.5 * a * dt) * dt
-            self._repeat_vel_mps += a * dt
+            ca = self._control_accel(a, dt)
+            self._repeat_motion.propagate(a, ca, dt)
             self._climb_vel_mps += (a - self._climb_vel_mps / p.climb_leak_s) * dt
-            control_predict(self._control, self._control_accel(a, dt), dt,
-                            p.control_accel_sigma_mps2)
+            control_predict(self._control, ca, dt, p.control_accel_sigma_mps2)
         alt_before = self._state()[0]
         self._history.append((t_s, alt_before))
         while self._history[0][0] < t_s - p.history_s:
@@ -338,7 +338,8 @@ class AltEstimator(ABC):
         if t_s - self._last_new_rx_s < p.sonar_repeat_s or t_s < self._doubt_until_s:
             return False
         lasted_s = t_s - self._value_rx_s
-        return abs(self._repeat_move_m) <= p.sonar_stale_move_m + p.sonar_stale_drift_mps * lasted_s
+        return (self._repeat_motion.moved_m()
+                <= p.sonar_stale_move_m + p.sonar_stale_drift_mps * lasted_s)
 
     def _sonar(self, sonar: Rangefinder, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
         d = sonar.distance_m if sonar.valid else 0.0
@@ -347,18 +348,23 @@ class AltEstimator(ABC):
         fresh = self._is_new_reading(d, sonar.t_s)
         changed = d != self._last_distance
         prev_new_t_s = self._last_new_t_s
+        # A sensor's silence is seen only in a stream that arrived whole: after the link lost
+        # frames, a new reading is the sensor's latest, not a late echo of a ping sent when
+        # the last reading before the gap arrived
+        silence_seen = sonar.link_lost == self._lost_at_new
         if fresh:
             self._last_distance, self._last_new_t_s = d, t_s
-            self._last_new_rx_s = sonar.t_s
-        result = self._use_reading(sonar, d, fresh, prev_new_t_s, t_s, alt_pred)
+            self._last_new_rx_s, self._lost_at_new = sonar.t_s, sonar.link_lost
+        result = self._use_reading(sonar, d, fresh, prev_new_t_s if silence_seen else t_s, t_s,
+                                   alt_pred)
         if changed and fresh:
             # this value measured the altitude of now for a prompt reading, of its ping for a
             # late echo (the clone still holds that until _on_ping)
             alt, vel = self._state()[:2]
-            self._repeat_vel_mps = vel
             self._value_rx_s = sonar.t_s
-            self._repeat_move_m = (self._late_shift(prev_new_t_s, alt)[0]
-                                   if self._reading_late else 0.0)
+            self._repeat_motion.restart(
+                self._late_shift(prev_new_t_s, alt)[0] if self._reading_late else 0.0,
+                vel, self._control[1])
         if fresh:
             # the HC-SR04 sends its next ping as soon as an echo (or its timeout) is in
             self._on_ping(t_s)
@@ -388,7 +394,7 @@ class AltEstimator(ABC):
         self._correct(z_ping_m + shift, t_s, var)
 
     def _use_reading(
-        self, sonar: Rangefinder, d: float, fresh: bool, prev_new_t_s: float, t_s: float,
+        self, sonar: Rangefinder, d: float, fresh: bool, ping_t_s: float, t_s: float,
         alt_pred: float,
     ) -> tuple[SonarStatus, float]:
         p = self.params
@@ -415,13 +421,13 @@ class AltEstimator(ABC):
         z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
         # The HC-SR04 does not ping again before an echo is back, so a reading after a long
         # silence is a late echo of a ping sent about when the previous reading arrived
-        # (carpet, thesis ch. 7): it measures the altitude of then, not of now.
-        late = self._initialised and p.late_gap_s < t_s - prev_new_t_s <= p.late_max_s
+        # (`ping_t_s`; carpet, thesis ch. 7): it measures the altitude of then, not of now.
+        late = self._initialised and p.late_gap_s < t_s - ping_t_s <= p.late_max_s
         self._reading_late = late
         if late and abs(z - alt_pred) > p.sonar_stale_move_m:
             # after a silence, the altitude of long ago: the sensor waits for late echoes here
             self._doubt_until_s = sonar.t_s + p.sonar_doubt_s
-        z_now = z + self._late_shift(prev_new_t_s, alt_pred)[0] if late else z
+        z_now = z + self._late_shift(ping_t_s, alt_pred)[0] if late else z
         innovation = z_now - alt_pred
         if not self._initialised:
             # the first in-range reading sets the altitude; nothing to gate it against yet
@@ -429,11 +435,11 @@ class AltEstimator(ABC):
             self._reset_alt(z)
             self._last_sonar_t_s = t_s
             return SonarStatus.USED, innovation
-        passed = self._gate_late(z, prev_new_t_s, alt_pred) if late else self._gate(z)
+        passed = self._gate_late(z, ping_t_s, alt_pred) if late else self._gate(z)
         if passed:
             self._rejected.clear()
             if late:
-                self._correct_late(z, prev_new_t_s, alt_pred, t_s)
+                self._correct_late(z, ping_t_s, alt_pred, t_s)
             else:
                 self._correct(z, t_s)
             self._last_sonar_t_s = t_s
@@ -472,17 +478,9 @@ class AltEstimator(ABC):
         lie on one straight line in time; else None."""
         p = self.params
         pts = [(t, z) for t, z in self._rejected if t >= t_s - p.reacquire_min_s]
-        n = len(pts)
-        if n < p.reacquire_track_count:
+        if len(pts) < p.reacquire_track_count:
             return None
-        mt = sum(t for t, _ in pts) / n
-        mz = sum(z for _, z in pts) / n
-        stt = sum((t - mt) ** 2 for t, _ in pts)
-        if stt <= 0.0:
-            return None
-        slope = sum((t - mt) * (z - mz) for t, z in pts) / stt
-        rms = math.sqrt(sum((z - mz - slope * (t - mt)) ** 2 for t, z in pts) / n)
-        return mz + slope * (t_s - mt) if rms <= p.reacquire_track_rms_m else None
+        return line_at(pts, t_s, p.reacquire_track_rms_m)
 
 
 def _copied(v: object) -> object:
@@ -491,4 +489,6 @@ def _copied(v: object) -> object:
         return deque(v)
     if isinstance(v, list):
         return [_copied(x) for x in v]
+    if isinstance(v, RepeatMotion):
+        return v.copy()
     return v

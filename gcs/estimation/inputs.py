@@ -1,5 +1,5 @@
 """Sensor conditioning shared by the estimators: vertical acceleration, sonar and barometric
-altitude."""
+altitude, a line through a run of readings."""
 
 from __future__ import annotations
 
@@ -26,6 +26,21 @@ def vertical_accel_up_mps2(acc_b: Vec3, roll_rad: float, pitch_rad: float) -> fl
 def sonar_altitude_m(distance_m: float, roll_rad: float, pitch_rad: float) -> float:
     """Height above the floor from a body-z slant range: distance · cos(roll) · cos(pitch)."""
     return distance_m * math.cos(roll_rad) * math.cos(pitch_rad)
+
+
+def line_at(points: list[tuple[float, float]], t_s: float, max_rms: float) -> float | None:
+    """The least-squares line through (time, value) `points`, evaluated at `t_s`; None when
+    its RMS residual exceeds `max_rms` or the times do not spread. (A handful of points, in
+    plain floats: faster than numpy's polyfit at this size.)"""
+    n = len(points)
+    mt = sum(t for t, _ in points) / n
+    mz = sum(z for _, z in points) / n
+    stt = sum((t - mt) ** 2 for t, _ in points)
+    if stt <= 0.0:
+        return None
+    slope = sum((t - mt) * (z - mz) for t, z in points) / stt
+    rms = math.sqrt(sum((z - mz - slope * (t - mt)) ** 2 for t, z in points) / n)
+    return mz + slope * (t_s - mt) if rms <= max_rms else None
 
 
 _ISA_P0_PA = 101325.0

@@ -244,3 +244,31 @@ def test_set_param_confirms_or_says_what_the_vehicle_stored(apm25: FakeVehicle) 
         with pytest.raises(ParamError, match="no value for parameter NOPE"):
             link.set_param("NOPE", 1.0, timeout_s=0.5)
         assert link.get_param("THR_MID") == 700.0
+
+
+def test_a_rangefinder_record_carries_the_frames_lost_before_it(apm25: FakeVehicle) -> None:
+    """The estimator tells a sonar's silence from the radio's by whether the stream between
+    two readings arrived whole: each reading carries the link's lost-frame count."""
+    from pymavlink.dialects.v10 import ardupilotmega as mav1
+
+    from firmware_link.records import Rangefinder
+
+    enc = mav1.MAVLink(None, srcSystem=1, srcComponent=50)  # a sender of its own sequence
+    with VehicleLink.open(apm25.url) as link:
+        poll_until(link, lambda rs: link.stats.rx_messages > 0)
+
+        def reading(seq: int, cm: int) -> Rangefinder:
+            enc.seq = seq
+            apm25.inject(mav1.MAVLink_rangefinder_message(cm / 100.0, 0.0)
+                         .pack(enc, force_mavlink1=True))
+
+            def mine(rs: list) -> list[Rangefinder]:  # the vehicle's own stream reads 0.75 m
+                return [r for r in rs if isinstance(r, Rangefinder)
+                        and round(r.distance_m * 100) == cm]
+            return mine(poll_until(link, lambda rs: bool(mine(rs))))[0]
+
+        first = reading(10, 95)
+        assert reading(11, 96).link_lost == first.link_lost  # nothing lost between
+        after_gap = reading(15, 97)  # three frames of that sender lost
+        assert after_gap.link_lost == first.link_lost + 3
+        assert after_gap.link_lost <= link.stats.lost_messages

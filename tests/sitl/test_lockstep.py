@@ -151,11 +151,29 @@ def test_frame_loss_is_whole_frames_at_its_rate_from_its_seed() -> None:
     assert run(3)[2] == data and run(4)[2] != data
 
 
+def test_frame_loss_keeps_to_its_window() -> None:
+    sitl = start(seed=1)
+    port = _open(sitl.vehicle_port(1, LinkFaults(loss=0.5, loss_start_s=1.0, loss_s=1.0)))
+    gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+    port.write(mavlink.MAVLink_request_data_stream_message(1, 1, 0, 40, 1)
+               .pack(gcs, force_mavlink1=True))
+    got, lost = [], []
+    for second in range(3):
+        sitl.advance_to(second + 0.995)
+        got.append(len(_decode(port.read(PORT_BACKLOG_BYTES))))
+        lost.append(port.lost_frames[0])
+    # before the window nothing is lost; in it about half; after it nothing more
+    assert lost[0] == 0 and lost[2] == lost[1] and 0.3 * got[2] < lost[1] < 0.7 * got[2]
+    assert 0.3 * got[2] < got[1] < 0.7 * got[2]
+
+
 def test_bad_faults_are_one_line() -> None:
     with pytest.raises(ValueError, match="fade 'sideways': expected one of none, down, up"):
         LinkFaults(fade="sideways")
     with pytest.raises(ValueError, match=r"loss 1.5: expected a probability in \[0, 1\)"):
         LinkFaults(loss=1.5)
+    with pytest.raises(ValueError, match="expected seconds >= 0"):
+        LinkFaults(loss=0.3, loss_s=-1.0)
 
 
 def test_a_port_nobody_opened_gets_nothing_as_a_tcp_endpoint_without_a_client() -> None:
