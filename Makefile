@@ -16,16 +16,24 @@ run: $(STAMP)
 	$(BIN)/quadgcs teleop
 
 # One BLAS thread: on two cores numpy's threaded linear algebra fights the test processes.
-# Two test processes, a file each at a time (a file's flights share module fixtures): most e2e
-# flights wait on real time, so two of them fit on two cores (26 min in one process, 12 in two).
-# Then the `solo` tests, alone: five stations at 2x want 1.4 cores, and starved of them by a
-# neighbour their loops tick 0.1-0.2 s late and the vehicles fall out of the air; lockstep
-# campaigns on two Ray workers would starve a wall-clock flight on the other test process.
+# Three passes:
+# - The rest, two test processes, a file each at a time (a file's flights share module
+#   fixtures): most e2e flights wait on real time, so two of them fit on two cores.
+# - The `wallclock` flights, three processes: each holds a wall-clock flight that a CPU-bound
+#   neighbour (a lockstep run, a planner's property test) would starve of its ticks, while
+#   together they use about a core (the real-time fault matrix, the TCP and serial steps, the
+#   carpet hold, the 1x TCP flights compared with lockstep).
+# - The `solo` tests, alone: five stations at 2x want 1.4 cores, and starved of them by a
+#   neighbour their loops tick 0.1-0.2 s late and the vehicles fall out of the air; the
+#   starved-SITL test's stalls are its own; lockstep campaigns on two Ray workers take both
+#   cores.
 test: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q -n 2 --dist loadfile --durations=25 \
-		-m "not solo"
+		-m "not solo and not wallclock"
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q -n 3 --dist loadfile --durations=10 \
+		-m wallclock
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q -m solo
 
 lint: $(STAMP)

@@ -74,13 +74,15 @@ def _sitl(args: list[str]) -> Iterator[Any]:
 
 def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
                    speedup: float = TCP_SPEEDUP, seed: int = 3,
-                   record: Path | None = None) -> FlightResult:
-    """Fly 1.0 m, start `case` 30 s into the hold, watch until it is over; the result.
+                   record: Path | None = None,
+                   after_hold_s: float = FAULT_AFTER_HOLD_S) -> FlightResult:
+    """Fly 1.0 m, start `case` `after_hold_s` (30 s) into the hold, watch until it is over;
+    the result.
     `record`: fly's MCAP recording to this file (default none: it costs the station CPU)."""
     if not speedup_allowed():
         speedup = 1.0
     wall0 = time.monotonic()
-    hold_s = FAULT_AFTER_HOLD_S + case.duration_s + (10.0 if case.lands else 8.0)
+    hold_s = after_hold_s + case.duration_s + (10.0 if case.lands else 8.0)
     udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     udp.bind(("127.0.0.1", 0))
     args = ["--tcp", "0", "--profile", profile, "--speedup", f"{speedup:g}", "--seed",
@@ -116,7 +118,7 @@ def fly_with_fault(case: FaultCase, profile: str, transport: str = "tcp",
         if speedup != 1.0:
             argv += ["--speedup", f"{speedup:g}"]
         budget_s = (60.0 + hold_s + case.duration_s) / speedup + 30.0
-        run = _run_fly(argv, proxy, case, budget_s)
+        run = _run_fly(argv, proxy, case, budget_s, after_hold_s)
         # keep watching: the vehicle may still be coming down after fly has given up
         t_fault = run["fault_wall"]
         if t_fault is not None:
@@ -154,8 +156,9 @@ def _disarmed_after(w: MavWatcher, wall: float) -> bool:
 
 
 def _run_fly(argv: list[str], proxy: FaultProxy, case: FaultCase,
-             budget_s: float) -> dict[str, Any]:
-    """Run fly; start the fault 30 s into its hold phase (seen on --live); collect output."""
+             budget_s: float, after_hold_s: float) -> dict[str, Any]:
+    """Run fly; start the fault `after_hold_s` into its hold phase (seen on --live); collect
+    output."""
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             cwd=ROOT, env=env)
@@ -174,7 +177,7 @@ def _run_fly(argv: list[str], proxy: FaultProxy, case: FaultCase,
                 last = word
                 out["phases"].append((time.monotonic(), word))
                 if word == "hold" and out["fault_wall"] is None:
-                    w = proxy.schedule(case.direction, FAULT_AFTER_HOLD_S, case.duration_s,
+                    w = proxy.schedule(case.direction, after_hold_s, case.duration_s,
                                        drop=case.drop, loss=case.loss, bitflip=case.bitflip)
                     out["fault_wall"] = proxy.monotonic_at(w.start_s)
                     if case.kill:
@@ -220,7 +223,8 @@ class FlightSpec:
 
 
 def run_many(specs: list[FlightSpec], seed: int = 3, speedup: float | None = None,
-             record_dir: Path | None = None) -> dict[FlightSpec, FlightResult | Exception]:
+             record_dir: Path | None = None, after_hold_s: float = FAULT_AFTER_HOLD_S,
+             ) -> dict[FlightSpec, FlightResult | Exception]:
     """Fly every spec, longest first, a few at a time: in real time a flight needs about a
     quarter of a core, sped up K times about K quarters. `speedup` None: TCP_SPEEDUP over TCP,
     SERIAL_SPEEDUP over serial, when `fly` allows it. `record_dir`: fly's MCAP and the watched
@@ -239,7 +243,8 @@ def run_many(specs: list[FlightSpec], seed: int = 3, speedup: float | None = Non
             k = speedup
         try:
             rec = None if record_dir is None else record_dir / f"{spec.id}.mcap"
-            r = fly_with_fault(CASES[spec.case], spec.profile, spec.transport, k, seed, rec)
+            r = fly_with_fault(CASES[spec.case], spec.profile, spec.transport, k, seed, rec,
+                               after_hold_s)
             if rec is not None:
                 r.save(rec.with_suffix(".npz"))
             return r

@@ -27,16 +27,18 @@ def fly_json(*argv: str) -> dict[str, Any]:
     return fly(args)
 
 
+# Beside wall-clock flights only (make test's `wallclock` pass): a SITL starved of CPU by a
+# lockstep neighbour falls behind and then sends its telemetry at once, and a step flown
+# through such bursts has overshot 96 % (see the starved-SITL test below for what the
+# estimator does with them)
+@pytest.mark.wallclock
 @pytest.mark.parametrize("profile", ["apm25", "copter4"])
 @pytest.mark.parametrize("transport", [
-    # Alone: a SITL starved of CPU falls behind and then sends its telemetry at once (see
-    # the starved-SITL test below for what the estimator does with such bursts)
-    pytest.param("tcp", marks=pytest.mark.solo),
+    "tcp",
     pytest.param("serial", marks=pytest.mark.xfail(
         strict=False, reason="on the 115200-baud line (telemetry at 16.7 Hz) the step settles "
-        "in 1.2 s alone (seed 3, 2x, both profiles), but this flight runs beside the other "
-        "test process's wall-clock flights, and a starved SITL's telemetry bursts have made "
-        "such a step overshoot (a TCP one: 96 %, so those run alone)")),
+        "in 1.2 s alone (seed 3, 2x, both profiles), but beside two other wall-clock flights "
+        "it has overshot 15.3 % (apm25) against the 15 % floor")),
 ])
 def test_holds_1m_and_settles_a_1m_step(transport: str, profile: str) -> None:
     """Over TCP, and over the product's own case: an APM 2.5 (or a 4.x board) on a 115200-baud
@@ -54,6 +56,8 @@ def test_holds_1m_and_settles_a_1m_step(transport: str, profile: str) -> None:
     assert step["settle_time_s"] is not None and step["settle_time_s"] <= 4.0
 
 
+# Alone (make test's `solo` pass): the stalls are the test; a third wall-clock neighbour's load
+# on top of them left copter4's step unsettled after 8 s in two runs of three at a time
 @pytest.mark.solo
 @pytest.mark.parametrize("profile", ["apm25", "copter4"])
 def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str) -> None:
@@ -85,10 +89,10 @@ def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str)
     assert step["settle_time_s"] is not None and step["settle_time_s"] <= 10.0
 
 
-# Alone: in one fresh-clone run, beside the other test process's wall-clock flights, this
+# Beside wall-clock flights only: in one fresh-clone run, beside a CPU-bound test, this
 # flight held at RMS 0.30 m (seed 3; 7-11 cm in 13 runs here, up to six at once, and in the
 # other fresh-clone runs): a starved SITL's bursts of late telemetry over carpet's late echoes
-@pytest.mark.solo
+@pytest.mark.wallclock
 def test_carpet_late_echoes_do_not_make_it_diverge() -> None:
     """Over carpet half the echoes are late (up to 1.2 s) or lost: the estimator must place the
     late ones at their ping and bridge the gaps (barometer offset learned against the sonar)."""

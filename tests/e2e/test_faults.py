@@ -1,10 +1,11 @@
 """`quadgcs fly` through a fault injector: the link dies one way, both ways, or turns lossy.
 
 Each flight: the SITL (its own program), the fault proxy between it and the station, and the
-real CLI `quadgcs fly --connect <proxy> --mocap <sitl mocap> --json`, holding 1.0 m. Thirty
-seconds into the hold the fault starts. Height is judged from motion capture, which the fault
-does not touch; the vehicle's arming state, mode and failsafe texts from a UDP endpoint of the
-SITL that only listens.
+real CLI `quadgcs fly --connect <proxy> --mocap <sitl mocap> --json`, holding 1.0 m. Twenty
+seconds into the hold the fault starts (bench/faults.py: thirty, as the issue measured; the
+hold has settled long before either, and the matrix's wall time is the suite's longest).
+Height is judged from motion capture, which the fault does not touch; the vehicle's arming
+state, mode and failsafe texts from a UDP endpoint of the SITL that only listens.
 
 What the station's policy promises: proof of life is any frame; a short gap holds a safe
 command; a gap over ~1 s makes it request LAND for a few seconds, then stop heartbeats and
@@ -26,7 +27,7 @@ import pytest
 from sitl.fault_frames import Direction
 from tests.e2e.fault_flight import CASES, FlightResult, FlightSpec, run_many
 
-pytestmark = [pytest.mark.e2e, pytest.mark.timeout(900)]
+pytestmark = [pytest.mark.e2e, pytest.mark.wallclock, pytest.mark.timeout(900)]
 
 MATRIX = [
     *(FlightSpec(case, profile) for case in ("downlink", "uplink", "both")
@@ -37,6 +38,7 @@ MATRIX = [
     # the product's own case: an APM 2.5 on its 115200-baud radio, out of range
     FlightSpec("both", "apm25", "serial"),
 ]
+AFTER_HOLD_S = 20.0
 MAX_OVER_SETPOINT_M = 0.3
 ROSE = "rose "  # the start of the problem line for a vehicle above that
 SANK = "touched down at "  # ...and for one that met the floor too fast
@@ -55,7 +57,7 @@ def flights(request: pytest.FixtureRequest) -> dict[FlightSpec, FlightResult | E
     """Every selected flight of this module, flown together."""
     wanted = [item.callspec.params["spec"] for item in request.session.items
               if item.module is request.module and hasattr(item, "callspec")]
-    return run_many(wanted)
+    return run_many(wanted, after_hold_s=AFTER_HOLD_S)
 
 
 def _problems(r: FlightResult) -> list[str]:

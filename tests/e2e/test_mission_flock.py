@@ -77,7 +77,6 @@ FADE_AT_S = 80.0  # simulated time: the team is in formation on its way to the c
 
 
 @pytest.mark.e2e
-@pytest.mark.solo  # a core for 50 s: beside a wall-clock flight it would take that one's ticks
 @pytest.mark.timeout(300)
 def test_one_vehicles_radio_fade_ends_the_mission_safely_for_all_five(tmp_path: Path) -> None:
     # lockstep: the five stations and the SITL on one simulated clock, vehicle 3's radio
