@@ -23,6 +23,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from open_loop import seed_range  # this directory, as the script runs
+
 from gcs.commands.fly import fly_session
 from gcs.errors import FlightFailed
 from gcs.flight import FlightPlan
@@ -59,18 +61,13 @@ def fly_lossy(profile: str, seed: int, record: Path | None = None) -> tuple[floa
     return float(np.abs(err).max()), float(np.sqrt(np.mean(err**2))), ended
 
 
-def _seeds(text: str) -> list[int]:
-    first, _, last = text.partition("-")
-    return list(range(int(first), int(last or first) + 1))
-
-
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", default="1-20", help="SITL seeds, FIRST-LAST (default 1-20)")
     ap.add_argument("--profiles", default="apm25,copter4", help="comma-separated profiles")
     ap.add_argument("--verbose", action="store_true", help="a line per flight")
     args = ap.parse_args()
-    seeds = _seeds(args.seeds)
+    seeds = seed_range(args.seeds)
     print(f"lockstep, 1.0 m hold, frame loss {LOSS:.3f} both ways from t = {LOSS_START_S:g} s "
           f"for {LOSS_S:g} s, seeds {seeds[0]}-{seeds[-1]}, truth heights")
     print(f"{'profile':8} {'worst |err| m med/max':>22} {'> 0.1 m':>7} {'RMS cm med/max':>15} "

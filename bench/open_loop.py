@@ -69,7 +69,8 @@ def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None]:
     return peak, float(max(0.0, -np.polyfit(t[sel] - t_c, alt[sel], 1)[0]))
 
 
-def _seeds(text: str) -> list[int]:
+def seed_range(text: str) -> list[int]:
+    """FIRST-LAST (or one seed) as the list of seeds."""
     first, _, last = text.partition("-")
     return list(range(int(first), int(last or first) + 1))
 
@@ -79,7 +80,7 @@ def main() -> int:
     ap.add_argument("--seeds", default="1-20", help="SITL seeds, FIRST-LAST (default 1-20)")
     ap.add_argument("--fade", default="up,both", help="fades: up, both, down (comma-separated)")
     args = ap.parse_args()
-    seeds = _seeds(args.seeds)
+    seeds = seed_range(args.seeds)
     print(f"lockstep, 1.0 m hold, {FADE_S:g} s fade from t = {FADE_START_S:g} s, seeds "
           f"{seeds[0]}-{seeds[-1]}, truth heights")
     print(f"{'profile':8} {'fade':5} {'peak m med/max':>15} {'> +0.3 m':>8} "
