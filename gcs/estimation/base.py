@@ -104,6 +104,9 @@ class AltEstimator(ABC):
         self._reject_seen_s = -math.inf  # last rejected reading, or a repeat of it
         self._catch_up = CatchUp()
         self._control = control_start(0.0, 0.0, 0.1**2)
+        # the hold's filter on the accelerometer alone, not the commands: a second velocity for
+        # the repeat test that, unlike the hold's, a rerun with other gains leaves as it was
+        self._twin = control_start(0.0, 0.0, 0.1**2)
         self._command_acc: float | None = None
         self._command_lagged = 0.0
         self._command_residual = 0.0
@@ -153,10 +156,11 @@ class AltEstimator(ABC):
         if dt > 0.0:
             self._predict(self._acc_up, dt)
             a = self._acc_up - self._state()[2]
-            ca = self._control_accel(a, dt)
-            self._repeat_motion.propagate(a, ca, dt)
+            self._repeat_motion.propagate(a, dt)
             self._climb_vel_mps += (a - self._climb_vel_mps / p.climb_leak_s) * dt
-            control_predict(self._control, ca, dt, p.control_accel_sigma_mps2)
+            control_predict(self._control, self._control_accel(a, dt), dt,
+                            p.control_accel_sigma_mps2)
+            control_predict(self._twin, a, dt, p.control_accel_sigma_mps2)
         alt_before = self._state()[0]
         self._history.append((t_s, alt_before))
         while self._history[0][0] < t_s - p.history_s:
@@ -191,13 +195,14 @@ class AltEstimator(ABC):
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
         ctl = self._control
-        if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or age > p.stale_after_s
-                or at_rest or not self._initialised):
-            control_follow(ctl, alt, vel, sigma)
-        elif status is SonarStatus.USED:
-            # the reading as the estimator took it: late echoes moved to the present
-            control_correct(ctl, alt_before + innovation,
-                            p.sonar_sigma_m**2 + p.sonar_resolution_m**2 / 12.0)
+        for f in (ctl, self._twin):
+            if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or age > p.stale_after_s
+                    or at_rest or not self._initialised):
+                control_follow(f, alt, vel, sigma)
+            elif status is SonarStatus.USED:
+                # the reading as the estimator took it: late echoes moved to the present
+                control_correct(f, alt_before + innovation,
+                                p.sonar_sigma_m**2 + p.sonar_resolution_m**2 / 12.0)
         return AltEstimate(
             t_s=t_s,
             alt_m=alt,
@@ -364,7 +369,7 @@ class AltEstimator(ABC):
             self._value_rx_s = sonar.t_s
             self._repeat_motion.restart(
                 self._late_shift(prev_new_t_s, alt)[0] if self._reading_late else 0.0,
-                vel, self._control[1])
+                vel, self._twin[1])
         if fresh:
             # the HC-SR04 sends its next ping as soon as an echo (or its timeout) is in
             self._on_ping(t_s)

@@ -48,14 +48,14 @@ def test_a_reading_after_lost_frames_corrects_the_estimate_at_once() -> None:
 
 def test_repeats_are_stale_only_when_both_velocities_say_the_vehicle_moved() -> None:
     m = RepeatMotion()
-    m.restart(0.0, -0.12, 0.0)  # the estimator's velocity errs; the hold's does not
+    m.restart(0.0, -0.12, 0.0)  # the estimator's velocity errs; the tighter filter's does not
     for _ in range(12):
-        m.propagate(0.0, 0.0, DT)
+        m.propagate(0.0, DT)
     assert m.moved_m() < 0.001
     m.restart(0.0, 0.2, 0.18)  # both see a climb
     for _ in range(12):
-        m.propagate(0.0, 0.0, DT)
+        m.propagate(0.0, DT)
     assert 0.05 < m.moved_m() < 0.06
     copy = m.copy()
-    m.propagate(1.0, 1.0, DT)
+    m.propagate(1.0, DT)
     assert copy.moved_m() < m.moved_m()
