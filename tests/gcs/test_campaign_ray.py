@@ -11,9 +11,12 @@ from typing import Any
 
 import pytest
 
-pytest.importorskip("ray", reason="the [campaign] extra is not installed")
-pytest.importorskip("optuna", reason="the [campaign] extra is not installed")
-pytest.importorskip("pyarrow", reason="the [campaign] extra is not installed")
+pytest.importorskip("ray", reason="the [campaign] extra is not installed "
+                    "(pip install -e '.[campaign]'; make test installs it)")
+pytest.importorskip("optuna", reason="the [campaign] extra is not installed "
+                    "(pip install -e '.[campaign]'; make test installs it)")
+pytest.importorskip("pyarrow", reason="the [campaign] extra is not installed "
+                    "(pip install -e '.[campaign]'; make test installs it)")
 
 from gcs.campaign import (
     BEST_NAME,

@@ -77,7 +77,8 @@ def test_series_follow_the_flight(recorded_flight) -> None:
 
 
 def test_plot_writes_a_png(recorded_flight, tmp_path, capsys) -> None:
-    pytest.importorskip("matplotlib", reason="the [plot] extra is not installed")
+    pytest.importorskip("matplotlib", reason="the [plot] extra is not installed "
+                        "(pip install -e '.[plot]'; make test installs it)")
     path, _ = recorded_flight
     out = tmp_path / "flight.png"
     assert main(["logs", "plot", str(path), "-o", str(out)]) == 0
@@ -95,7 +96,8 @@ def test_plot_without_matplotlib_is_one_line_exit_1(recorded_flight, tmp_path, c
 
 
 def test_plot_of_a_flight_without_station_topics_is_refused(tmp_path) -> None:
-    pytest.importorskip("matplotlib", reason="the [plot] extra is not installed")
+    pytest.importorskip("matplotlib", reason="the [plot] extra is not installed "
+                        "(pip install -e '.[plot]'; make test installs it)")
     with Recorder(tmp_path / "raw.mcap", metadata={}) as rec:
         rec.put_raw("rx", 1.0, b"\xfd\x00\x00\x00\x00\x01\x01\x00\x00\x00\x00\x00")
     from logs import RecordingError

@@ -73,7 +73,8 @@ def test_info_replay_and_plot_on_the_flight(sitl_flight, tmp_path, capsys) -> No
     lines = capsys.readouterr().out.splitlines()
     assert any("mode ALT_HOLD" in line or "mode STABILIZE" in line for line in lines)
     assert lines[-1].startswith("replayed ")
-    pytest.importorskip("matplotlib", reason="the [plot] extra is not installed")
+    pytest.importorskip("matplotlib", reason="the [plot] extra is not installed "
+                        "(pip install -e '.[plot]'; make test installs it)")
     assert main(["logs", "plot", str(sitl_flight), "-o", str(tmp_path / "f.png")]) == 0
 
 
