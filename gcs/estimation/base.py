@@ -195,14 +195,15 @@ class AltEstimator(ABC):
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
         ctl = self._control
-        for f in (ctl, self._twin):
-            if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or age > p.stale_after_s
-                    or at_rest or not self._initialised):
-                control_follow(f, alt, vel, sigma)
-            elif status is SonarStatus.USED:
-                # the reading as the estimator took it: late echoes moved to the present
-                control_correct(f, alt_before + innovation,
-                                p.sonar_sigma_m**2 + p.sonar_resolution_m**2 / 12.0)
+        if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or age > p.stale_after_s
+                or at_rest or not self._initialised):
+            control_follow(ctl, alt, vel, sigma)
+            control_follow(self._twin, alt, vel, sigma)
+        elif status is SonarStatus.USED:
+            # the reading as the estimator took it: late echoes moved to the present
+            r = p.sonar_sigma_m**2 + p.sonar_resolution_m**2 / 12.0
+            control_correct(ctl, alt_before + innovation, r)
+            control_correct(self._twin, alt_before + innovation, r)
         return AltEstimate(
             t_s=t_s,
             alt_m=alt,
@@ -354,14 +355,13 @@ class AltEstimator(ABC):
         changed = d != self._last_distance
         prev_new_t_s = self._last_new_t_s
         # A sensor's silence is seen only in a stream that arrived whole: after the link lost
-        # frames, a new reading is the sensor's latest, not a late echo of a ping sent when
-        # the last reading before the gap arrived
-        silence_seen = sonar.link_lost == self._lost_at_new
+        # frames, a new reading is the sensor's latest (its ping is now), not a late echo of a
+        # ping sent when the last reading before the gap arrived
+        ping_t_s = prev_new_t_s if sonar.link_lost == self._lost_at_new else t_s
         if fresh:
             self._last_distance, self._last_new_t_s = d, t_s
             self._last_new_rx_s, self._lost_at_new = sonar.t_s, sonar.link_lost
-        result = self._use_reading(sonar, d, fresh, prev_new_t_s if silence_seen else t_s, t_s,
-                                   alt_pred)
+        result = self._use_reading(sonar, d, fresh, ping_t_s, t_s, alt_pred)
         if changed and fresh:
             # this value measured the altitude of now for a prompt reading, of its ping for a
             # late echo (the clone still holds that until _on_ping)
