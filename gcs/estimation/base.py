@@ -270,7 +270,8 @@ class AltEstimator(ABC):
 
     def snapshot(self) -> object:
         """The filter's state, to be put back by `restore` (its containers copied)."""
-        return {k: _copied(v) for k, v in vars(self).items() if k != "_catch_up"}
+        return {k: _copied(v) if isinstance(v, _CONTAINERS) else v  # taken every tick
+                for k, v in vars(self).items() if k != "_catch_up"}
 
     def restore(self, state: object) -> None:
         assert isinstance(state, dict)
@@ -488,12 +489,11 @@ class AltEstimator(ABC):
         return line_at(pts, t_s, p.reacquire_track_rms_m)
 
 
+_CONTAINERS = (deque, list, RepeatMotion)
+
+
 def _copied(v: object) -> object:
     """A copy of a filter attribute that shares nothing mutable with it."""
-    if isinstance(v, deque):
-        return deque(v)
     if isinstance(v, list):
-        return [_copied(x) for x in v]
-    if isinstance(v, RepeatMotion):
-        return v.copy()
-    return v
+        return [_copied(x) if isinstance(x, _CONTAINERS) else x for x in v]
+    return deque(v) if isinstance(v, deque) else v.copy() if isinstance(v, RepeatMotion) else v

@@ -93,7 +93,9 @@ class CatchUp:
         self.implausible = 0  # vehicle times ahead of the station's clock: not learned from
         self._taken: dict[int, float] = {}  # vehicle time -> tick, oldest first, in the window
         self._kept: deque[_Kept] = deque()
-        self._offsets: deque[tuple[float, float]] = deque()  # (tick, rx time - vehicle time)
+        # (tick, rx time - vehicle time), offsets rising: an entry with a later, smaller one
+        # can never be the window's least again, so it is dropped when that one comes
+        self._offsets: deque[tuple[float, float]] = deque()
 
     def tick(self, est: Restorable, inputs: TickInputs,
              step: Callable[[TickInputs], object]) -> object:
@@ -165,13 +167,16 @@ class CatchUp:
         if least is not None and offset < least - self.params.max_window_s:
             self.implausible += 1
             return
-        self._offsets.append((inputs.t_s, offset))
-        while self._offsets[0][0] < inputs.t_s - self.params.offset_window_s:
-            self._offsets.popleft()
+        offsets = self._offsets
+        while offsets and offsets[-1][1] >= offset:
+            offsets.pop()
+        offsets.append((inputs.t_s, offset))
+        while offsets[0][0] < inputs.t_s - self.params.offset_window_s:
+            offsets.popleft()
 
     def _offset_s(self) -> float | None:
         """Station time minus vehicle time of the promptest recent sample (the least delay)."""
-        return min(o for _, o in self._offsets) if self._offsets else None
+        return self._offsets[0][1] if self._offsets else None
 
 
 def _redistributed(earlier: list[TickInputs], now: TickInputs,

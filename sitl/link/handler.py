@@ -16,6 +16,7 @@ SYS_STATUS go out, once a second, and the COMMAND_ACK comes when arming is done.
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Callable
 from typing import Any
 
@@ -54,6 +55,8 @@ _BUILDERS: dict[str, Callable[[VehicleView], Any]] = {
     "SIM_STATE": tm.sim_state,
     **telemetry_full.BUILDERS,
 }
+
+_OVERRIDE_CHANNELS = operator.attrgetter(*(f"chan{i}_raw" for i in range(1, 9)))
 
 
 def _name_of(raw: Any) -> str:
@@ -106,8 +109,7 @@ class VehicleLink:
                 ap.gcs_seen(t)
         elif kind == "RC_CHANNELS_OVERRIDE":
             if src == gcs_id and msg.target_system == v.sysid:
-                values = [getattr(msg, f"chan{i}_raw") for i in range(1, 9)]
-                ap.rc_override(values, t)
+                ap.rc_override(_OVERRIDE_CHANNELS(msg), t)
         elif kind == "SET_MODE":
             if msg.target_system == v.sysid:
                 ok = bool(msg.base_mode & MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
