@@ -3,7 +3,9 @@
 `--address HOST:PORT` (or `RAY_ADDRESS`) joins a running cluster without changing the file;
 every node needs quadgcs installed as here. An address nobody answers at is one line, found
 with a plain TCP connect first (Ray itself retries for minutes). The local Ray starts with the
-number of CPUs asked (all of this machine's by default) and no dashboard.
+number of CPUs asked (all of this machine's by default), no dashboard, and none of what only
+the dashboard and the state API read (metrics export, task events, the timeline): on two
+cores their threads cost the runs about 4 % of the CPU.
 
 Each run is one task of one CPU. A task that raised or whose worker died still gives a row
 (`failed`, with the reason), so the campaign goes on. Ctrl-C cancels what has not finished and
@@ -26,6 +28,10 @@ from gcs.errors import RuntimeFault, UsageError
 
 ADDRESS_ENV = "RAY_ADDRESS"
 CONNECT_TIMEOUT_S = 3.0
+# Ray's system settings (ray_config_def.h) for the embedded Ray only: a cluster joined keeps
+# whatever it was started with
+LOCAL_SYSTEM_CONFIG = {"enable_metrics_collection": False, "task_events_report_interval_ms": 0,
+                       "enable_timeline": False}
 
 
 def need(module: str) -> Any:
@@ -69,7 +75,8 @@ def ray_session(address: str | None, num_cpus: int | None) -> Iterator[Any]:
             raise RuntimeFault(f"--address {address}: cannot join the Ray cluster ({first})"
                                ) from None
     else:
-        ray.init(num_cpus=num_cpus, include_dashboard=False, **quiet)
+        ray.init(num_cpus=num_cpus, include_dashboard=False,
+                 _system_config=LOCAL_SYSTEM_CONFIG, **quiet)
     try:
         yield ray
     finally:
