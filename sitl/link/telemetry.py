@@ -35,12 +35,23 @@ MAV_SENSOR_ROTATION_PITCH_270 = 25  # facing down
 _SENSORS = 0x1 | 0x2 | 0x8 | 0x100 | 0x400 | 0x800 | 0x2000 | 0x8000 | 0x10000 | 0x2000000
 
 
-def _boot_ms(v: VehicleView) -> int:
+def boot_ms(v: VehicleView) -> int:
+    """Milliseconds since boot, as a uint32 field wraps them."""
     return int(v.t_s * 1000.0) & 0xFFFFFFFF
 
 
-def _clamp16(x: float) -> int:
+def clamp16(x: float) -> int:
+    """Rounded into an int16 field."""
     return max(-32768, min(32767, round(x)))
+
+
+def imu_units(v: VehicleView) -> tuple[int, int, int, int, int, int]:
+    """The accelerometer in mg and the gyro in mrad/s, as every IMU message carries them."""
+    c = v.cache
+    k = 1000.0 / GRAVITY_MSS
+    acc, gyro = c.acc_b, c.gyro_b
+    return (clamp16(acc[0] * k), clamp16(acc[1] * k), clamp16(acc[2] * k),
+            clamp16(gyro[0] * 1000.0), clamp16(gyro[1] * 1000.0), clamp16(gyro[2] * 1000.0))
 
 
 def heartbeat(v: VehicleView) -> Any:
@@ -72,46 +83,21 @@ def attitude(v: VehicleView) -> Any:
     st = v.autopilot.state
     p, q, r = st.gyro_rads
     return messages.MAVLink_attitude_message(
-        _boot_ms(v), st.roll_rad, st.pitch_rad, st.yaw_rad, p, q, r
+        boot_ms(v), st.roll_rad, st.pitch_rad, st.yaw_rad, p, q, r
     )
 
 
 def raw_imu(v: VehicleView) -> Any:
     """RAW_IMU in mg and mrad/s (see module docstring)."""
-    c = v.cache
-    k = 1000.0 / GRAVITY_MSS
     return messages.MAVLink_raw_imu_message(
-        int(v.t_s * 1e6),
-        _clamp16(c.acc_b[0] * k),
-        _clamp16(c.acc_b[1] * k),
-        _clamp16(c.acc_b[2] * k),
-        _clamp16(c.gyro_b[0] * 1000.0),
-        _clamp16(c.gyro_b[1] * 1000.0),
-        _clamp16(c.gyro_b[2] * 1000.0),
-        0,
-        0,
-        0,
-        0,
-        _clamp16(c.temperature_c * 100.0),
+        int(v.t_s * 1e6), *imu_units(v), 0, 0, 0, 0, clamp16(v.cache.temperature_c * 100.0)
     )
 
 
 def scaled_imu(v: VehicleView) -> Any:
     """SCALED_IMU (Copter 4.x), same units as RAW_IMU."""
-    c = v.cache
-    k = 1000.0 / GRAVITY_MSS
     return messages.MAVLink_scaled_imu_message(
-        _boot_ms(v),
-        _clamp16(c.acc_b[0] * k),
-        _clamp16(c.acc_b[1] * k),
-        _clamp16(c.acc_b[2] * k),
-        _clamp16(c.gyro_b[0] * 1000.0),
-        _clamp16(c.gyro_b[1] * 1000.0),
-        _clamp16(c.gyro_b[2] * 1000.0),
-        0,
-        0,
-        0,
-        _clamp16(c.temperature_c * 100.0),
+        boot_ms(v), *imu_units(v), 0, 0, 0, clamp16(v.cache.temperature_c * 100.0)
     )
 
 
@@ -119,7 +105,7 @@ def scaled_pressure(v: VehicleView) -> Any:
     """SCALED_PRESSURE: hPa and centidegrees."""
     c = v.cache
     return messages.MAVLink_scaled_pressure_message(
-        _boot_ms(v), c.pressure_pa / 100.0, 0.0, _clamp16(c.temperature_c * 100.0), 0
+        boot_ms(v), c.pressure_pa / 100.0, 0.0, clamp16(c.temperature_c * 100.0), 0
     )
 
 
@@ -161,8 +147,8 @@ def rc_channels(v: VehicleView) -> Any:
     """RC_CHANNELS_RAW (3.2.1) or RC_CHANNELS (4.x): what the autopilot sees."""
     ch = v.autopilot.radio.channels()
     if v.profile is Profile.APM25:
-        return messages.MAVLink_rc_channels_raw_message(_boot_ms(v), 0, *ch, 255)
-    return messages.MAVLink_rc_channels_message(_boot_ms(v), 8, *ch, *([0] * 10), 255)
+        return messages.MAVLink_rc_channels_raw_message(boot_ms(v), 0, *ch, 255)
+    return messages.MAVLink_rc_channels_message(boot_ms(v), 8, *ch, *([0] * 10), 255)
 
 
 def servo_output_raw(v: VehicleView) -> Any:
@@ -196,7 +182,7 @@ def distance_sensor_down(v: VehicleView) -> Any:
     """DISTANCE_SENSOR for the down sonar (4.x): uint16 centimetres."""
     p = v.params
     return messages.MAVLink_distance_sensor_message(
-        _boot_ms(v),
+        boot_ms(v),
         round(p.k(Key.RNG_MIN_M) * 100.0),
         round(p.k(Key.RNG_MAX_M) * 100.0),
         rangefinder_cm(v),

@@ -16,20 +16,12 @@ from typing import Any
 
 from sitl.autopilot import FlightMode
 from sitl.link.codec import messages
+from sitl.link.telemetry import GRAVITY_MSS, boot_ms, clamp16, imu_units
 from sitl.link.view import VehicleView
 
-GRAVITY_MSS = 9.80665
 GPS_NO_FIX = 1
 EKF_FLAGS_ATTITUDE_VERT = 0x1 | 0x4 | 0x8 | 0x20  # attitude, vertical velocity/position
 ESC_RPM_AT_FULL = 12000.0
-
-
-def _boot_ms(v: VehicleView) -> int:
-    return int(v.t_s * 1000.0) & 0xFFFFFFFF
-
-
-def _clamp16(x: float) -> int:
-    return max(-32768, min(32767, round(x)))
 
 
 def ahrs(v: VehicleView) -> Any:
@@ -49,14 +41,14 @@ def global_position_int(v: VehicleView) -> Any:
     st = v.autopilot.state
     hdg = round(math.degrees(st.yaw_rad) % 360.0 * 100.0) % 36000
     return messages.MAVLink_global_position_int_message(
-        _boot_ms(v),
+        boot_ms(v),
         0,
         0,
         round((v.origin.alt_amsl_m + st.alt_m) * 1000.0),
         round(st.alt_m * 1000.0),
         0,
         0,
-        _clamp16(-st.climb_ms * 100.0),
+        clamp16(-st.climb_ms * 100.0),
         hdg,
     )
 
@@ -95,7 +87,7 @@ def nav_controller_output(v: VehicleView) -> Any:
 
 def system_time(v: VehicleView) -> Any:
     """SYSTEM_TIME: no GPS, so no UNIX time."""
-    return messages.MAVLink_system_time_message(0, _boot_ms(v))
+    return messages.MAVLink_system_time_message(0, boot_ms(v))
 
 
 def terrain_report(v: VehicleView) -> Any:
@@ -119,33 +111,21 @@ def sensor_offsets(v: VehicleView) -> Any:
 
 def scaled_imu2(v: VehicleView) -> Any:
     """SCALED_IMU2: the airframe has one IMU; the second instance reports the same sensor."""
-    c = v.cache
-    k = 1000.0 / GRAVITY_MSS
     return messages.MAVLink_scaled_imu2_message(
-        _boot_ms(v),
-        _clamp16(c.acc_b[0] * k),
-        _clamp16(c.acc_b[1] * k),
-        _clamp16(c.acc_b[2] * k),
-        _clamp16(c.gyro_b[0] * 1000.0),
-        _clamp16(c.gyro_b[1] * 1000.0),
-        _clamp16(c.gyro_b[2] * 1000.0),
-        0,
-        0,
-        0,
-        _clamp16(c.temperature_c * 100.0),
+        boot_ms(v), *imu_units(v), 0, 0, 0, clamp16(v.cache.temperature_c * 100.0)
     )
 
 
 def scaled_imu3(v: VehicleView) -> Any:
     """SCALED_IMU3: no third IMU (the 4.7 SITL's INS_ACC3_ID is 0): zeros."""
-    return messages.MAVLink_scaled_imu3_message(_boot_ms(v), 0, 0, 0, 0, 0, 0, 0, 0, 0, 0)
+    return messages.MAVLink_scaled_imu3_message(boot_ms(v), 0, 0, 0, 0, 0, 0, 0, 0, 0, 0)
 
 
 def scaled_pressure2(v: VehicleView) -> Any:
     """SCALED_PRESSURE2: the second barometer instance reports the same sensor."""
     c = v.cache
     return messages.MAVLink_scaled_pressure2_message(
-        _boot_ms(v), c.pressure_pa / 100.0, 0.0, _clamp16(c.temperature_c * 100.0), 0
+        boot_ms(v), c.pressure_pa / 100.0, 0.0, clamp16(c.temperature_c * 100.0), 0
     )
 
 
