@@ -37,10 +37,11 @@ FADE_S = 15.0
 SETPOINT_M = 1.0
 AFTER_S = 25.0
 FLOOR_BAND_M = 0.03
+HELD_S = 10.0  # the hold's level: the median truth height over this long before the fade
 
 
 def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None]:
-    """(peak height above the floor after the fade began, touchdown speed or None)."""
+    """(peak height after the fade began, on the setpoint's scale, touchdown speed or None)."""
     options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
                              fix_failsafe=True)
     faults = {"fade": fade, "fade_start_s": FADE_START_S, "fade_s": FADE_S}
@@ -60,7 +61,11 @@ def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None]:
     t, alt = series.t_s, series.alt_m
     floor = float(alt[: max(1, min(50, alt.size))].min())
     after = t >= FADE_START_S
-    peak = float(alt[after].max() - floor)
+    # heights from the level the hold kept before the fade, not from the floor: above the
+    # truth's resting height the hold sits a few cm under its setpoint (0.93-0.95 m for 1.0 m),
+    # which a peak counted from the floor would take as headroom
+    held = float(np.median(alt[(t >= FADE_START_S - HELD_S) & ~after]))
+    peak = SETPOINT_M + float(alt[after].max()) - held
     down = np.nonzero(after & (alt <= floor + FLOOR_BAND_M))[0]
     if not down.size:
         return peak, None
