@@ -101,6 +101,7 @@ class SimVehicle:
         c0.voltage_v = terminal_voltage_v(self.params, c0.used_mah, c0.current_a)
         self.t_s = 0.0
         self._f_b_mean: Vec3 | None = None  # specific force averaged over the last step
+        self._truth: TruthState | None = None  # built on the first look after a step
         self._substep: physics.SubStep | None = None  # constants of the last step's sub-steps
         s = world.sensors
         r_imu, r_sonar, r_baro, r_prox, r_rad, r_mocap = rng.spawn(6)
@@ -166,6 +167,7 @@ class SimVehicle:
                 mocap.capture(t, (c.x, c.y, c.z), (c.qw, c.qx, c.qy, c.qz))
         self.t_s = t0 + dt_s
         self._f_b_mean = (sfx / n, sfy / n, sfz / n)
+        self._truth = None
 
     def set_pose(
         self,
@@ -190,16 +192,19 @@ class SimVehicle:
         if c.on_ground:
             c.z = rest_z
         self._f_b_mean = None
+        self._truth = None
 
     # --- truth and power ----------------------------------------------------------------
 
     @property
     def truth(self) -> TruthState:
-        """Ground truth now."""
+        """Ground truth now (one object per step: the simulation and the truth feed both look)."""
+        if self._truth is not None:
+            return self._truth
         c = self._core
         q = (c.qw, c.qx, c.qy, c.qz)
         roll, pitch, yaw = quat_to_euler(q)
-        return TruthState(
+        self._truth = TruthState(
             t_s=self.t_s,
             pos_n=(c.x, c.y, c.z),
             vel_n=(c.vx, c.vy, c.vz),
@@ -214,6 +219,7 @@ class SimVehicle:
             collided_with=c.collided_with,
             collisions=c.collisions,
         )
+        return self._truth
 
     @property
     def battery(self) -> BatteryState:
