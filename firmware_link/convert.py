@@ -17,6 +17,7 @@ Scalings, as ArduPilot fills the messages:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -74,6 +75,8 @@ class RecordConverter:
 
     autopilot_compid: int = AUTOPILOT_COMPID
     sonar: SonarLimits = field(default_factory=SonarLimits)
+    # the link's lost frames so far, stamped on each rangefinder reading (`Rangefinder.link_lost`)
+    lost_frames: Callable[[], int] = lambda: 0
     _origin: dict[int, tuple[float, float]] = field(default_factory=dict)
     _origin_alt: dict[int, float] = field(default_factory=dict)
 
@@ -134,6 +137,7 @@ class RecordConverter:
             distance_m=distance_m,
             valid=valid,
             source="RANGEFINDER",
+            link_lost=self.lost_frames(),
         )
 
     def _distance_sensor(self, msg: Any, t_s: float) -> Rangefinder | Proximity | None:
@@ -149,6 +153,7 @@ class RecordConverter:
                 distance_m=distance_m,
                 valid=valid,
                 source="DISTANCE_SENSOR",
+                link_lost=self.lost_frames(),
             )
         try:
             facing = ProximityFacing(msg.orientation)

@@ -11,7 +11,6 @@ lossy radio while telemetry flows says nothing about the link; silence does.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections import deque
@@ -29,7 +28,6 @@ from firmware_link.records import (
     Heartbeat,
     LinkEvent,
     LinkEventKind,
-    Rangefinder,
     StatusText,
     TelemetryRecord,
 )
@@ -74,7 +72,7 @@ class LinkCore(TransportUpkeep):
         self._clock = clock
         self._wall_clock = wall_clock
         self._signing_key = signing_key
-        self._convert = RecordConverter()
+        self._convert = RecordConverter(lost_frames=lambda: self._ep.tally.lost_messages)
         self._pending: list[TelemetryRecord] = []
         self._statustexts: deque[StatusText] = deque(maxlen=20)
         self._param_types: dict[str, int] = {}
@@ -232,8 +230,6 @@ class LinkCore(TransportUpkeep):
         elif kind == "AUTOPILOT_VERSION" and from_autopilot:
             self._evidence.autopilot_version(msg)
         for record in self._convert.convert(msg, now):
-            if isinstance(record, Rangefinder):
-                record = dataclasses.replace(record, link_lost=self._ep.tally.lost_messages)
             if isinstance(record, Heartbeat) and record.compid == self._target_component:
                 self._on_vehicle_heartbeat(record, now)
             elif isinstance(record, StatusText):
