@@ -138,21 +138,29 @@ class AltitudeController:
         return round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
 
     def update(self, setpoint_m: float, estimate: AltEstimate, roll_rad: float, pitch_rad: float,
-               dt_s: float, *, on_floor: bool = False,
-               rate_mps: float | None = None) -> AltControlOutput:
+               dt_s: float, *, on_floor: bool = False, rate_mps: float | None = None,
+               sink_limit_mps2: float | None = None) -> AltControlOutput:
         """One step: setpoint altitude (up, m) and the estimate → throttle stick PWM.
 
         `on_floor`: the vehicle stands on the floor, so thrust below its weight changes nothing
         and the integrator must not wind up against it. `rate_mps`: the setpoint profile's speed
-        for this move (None: the controller's own)."""
+        for this move (None: the controller's own). `sink_limit_mps2` (≥ 0): the most downward
+        acceleration the command may ask below the learned hover (and below the integrator
+        when it trims that hover down); None: only the PID's own limits."""
         p = self.params
         alt = _flown_alt(estimate)
         error = setpoint_m - alt
         integrate = not (on_floor or (self._clamped > 0 and error > 0.0)
                          or (self._clamped < 0 and error < 0.0))
         vel = estimate.vel_mps if estimate.control_vel_mps is None else estimate.control_vel_mps
+        # Counted from the learned hover, less any trim the integrator takes off it (a hover
+        # learned too high): never from a trim it adds, for an integrator wound up on a wrong
+        # estimate (carpet) is no trim, and a floor above the hover would hold a climb for ever.
+        out_min = (None if sink_limit_mps2 is None
+                   else min(self.pid.integrator, 0.0) - sink_limit_mps2)
         terms: PidTerms = self.pid.update(setpoint_m, alt, dt_s, measurement_rate=vel,
-                                          integrate=integrate, slew_per_s=rate_mps)
+                                          integrate=integrate, slew_per_s=rate_mps,
+                                          out_min=out_min)
         tilt = self._tilt(roll_rad, pitch_rad)
         thrust = p.mass_kg * (GRAVITY_MPS2 + terms.out) / tilt
         motor = self.hover_throttle * thrust / (p.mass_kg * GRAVITY_MPS2)
@@ -160,7 +168,7 @@ class AltitudeController:
         throttle_us = round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
         self._clamped = 1 if stick > p.throttle_max_us else -1 if stick < p.throttle_min_us else 0
         g = p.gains
-        full = (self._clamped > 0 or (terms.saturated and terms.out > 0.0)
+        full = (self._clamped > 0 or terms.out >= g.out_max
                 or (terms.error >= g.error_max and terms.i >= p.blocked_climb_i_share * g.i_max))
         blocked = full and not on_floor and vel < p.blocked_climb_vel_mps
         self.blocked_climb_s = self.blocked_climb_s + dt_s if blocked else 0.0

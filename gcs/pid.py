@@ -188,14 +188,17 @@ class Pid:
         *,
         integrate: bool = True,
         slew_per_s: float | None = None,
+        out_min: float | None = None,
     ) -> PidTerms:
         """One step: returns the terms and the saturated output. With `integrate` False the
         integrator holds its value (the caller knows the actuator beyond the PID is clamped, or
         the plant cannot respond, e.g. a vehicle standing on the floor). `slew_per_s` lowers the
-        setpoint profile's speed for this move (a slow climb), braking as the profile does."""
+        setpoint profile's speed for this move (a slow climb), braking as the profile does.
+        `out_min` raises the output's lower limit for this step (never lowers it)."""
         if dt_s <= 0.0:
             raise ValueError(f"dt_s must be > 0, got {dt_s}")
         g = self.gains
+        lo = g.out_min if out_min is None else min(max(out_min, g.out_min), g.out_max)
         if self._shaped is None:
             self._shaped = target
         prev_rate = self._shaped_rate
@@ -227,11 +230,11 @@ class Pid:
         unsat = p + i_next + self._d + ff
         # conditional integration: don't integrate further into a saturated output
         if (not integrate or (unsat > g.out_max and leashed > 0.0)
-                or (unsat < g.out_min and leashed < 0.0)):
+                or (unsat < lo and leashed < 0.0)):
             i_next = self._i
         self._i = min(max(i_next, -g.i_max), g.i_max)
         total = p + self._i + self._d + ff
-        out = min(max(total, g.out_min), g.out_max)
+        out = min(max(total, lo), g.out_max)
         self._last_out = out
         return PidTerms(
             target=target,

@@ -25,6 +25,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from firmware_link.records import Dialect
+from gcs.supervisor.envelope import BlindFlight
 
 
 @dataclass(frozen=True, slots=True)
@@ -67,6 +68,15 @@ class SupervisorParams:
     # 3.2.1's AUTO_DISARMING_DELAY is a compile-time 15 s; 4.x's DISARM_DELAY defaults to 10 s.
     # Whatever arms a vehicle on the floor must take off (or disarm it) well before.
     auto_disarm_s: float = 15.0
+    # A hold's command flown blind (envelope.py): for this long (3.2.1's radio failsafe at 2 s;
+    # 4.x's FS_GCS_TIMEOUT, under RC_OVERRIDE_TIME's default 3 s), then the firmware's LAND
+    # brakes at least this hard (its z controller allows 2.5 m/s²), and the vehicle may meet
+    # the floor this fast at most: 1.0 m/s less the learned hover's and the motors' slack
+    # (inf: unbounded)
+    blind_s: float = 2.5
+    blind_brake_mps2: float = 1.0
+    blind_touchdown_mps: float = 0.8
+    blind_steady_mps: float = 0.25  # the hold's own wander is a few cm/s
 
     def __post_init__(self) -> None:
         if not 0.0 < self.degraded_after_s < self.lost_after_s:
@@ -76,6 +86,11 @@ class SupervisorParams:
             if isinstance(v, float) and v < 0.0:
                 raise ValueError(f"{f.name} must be >= 0, got {v}")
 
+    def blind(self, max_mps2: float) -> BlindFlight:
+        """The blind-flight envelope, for a hold that asks at most `max_mps2`."""
+        return BlindFlight(self.blind_s, self.blind_brake_mps2, self.blind_touchdown_mps,
+                           self.blind_steady_mps, max_mps2)
+
     @classmethod
     def for_dialect(cls, dialect: Dialect, **overrides: object) -> SupervisorParams:
         """The policy for one firmware (unknown: the stricter 4.x timings without force)."""
@@ -83,7 +98,7 @@ class SupervisorParams:
             base = cls()
         elif dialect is Dialect.COPTER4:
             base = cls(spool_s=3.0, force_disarm=True, stabilize_to_disarm=False,
-                       auto_disarm_s=10.0)
+                       auto_disarm_s=10.0, blind_s=3.0)
         else:
-            base = cls(spool_s=3.0, auto_disarm_s=10.0)
+            base = cls(spool_s=3.0, auto_disarm_s=10.0, blind_s=3.0)
         return dataclasses.replace(base, **overrides)  # type: ignore[arg-type]

@@ -14,6 +14,8 @@ The rules, most severe first (see `params` for the link-loss policy):
   throttle stays at minimum until the pilot's stick comes down to meet it.
 - Take-off waits for the motors: throttle minimum through the spool-up, then an open-loop ramp
   that stops the moment the vehicle is seen to leave the floor; only then does the PID run.
+- A steady hold asks no more down than the vehicle could fly blind until its failsafe
+  (`envelope`): a radio fade then cannot put it on the floor faster than the bound.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from firmware_link.records import FlightMode, RcCommand
 from gcs.altitude_controller import AltControlOutput, AltitudeController
 from gcs.estimation import SonarStatus
 from gcs.position_controller import PositionCommand, PositionController, PositionSetpoint
+from gcs.supervisor.envelope import blind_sink_limit
 from gcs.supervisor.params import SupervisorParams
 from gcs.supervisor.types import (
     AIRBORNE_CAPABLE,
@@ -63,6 +66,7 @@ class Supervisor:
         self.pos_ctrl = pos_ctrl
         self.rest_alt_m = rest_alt_m
         self.ground_alt_m = ground_alt_m
+        self._blind = params.blind(alt_ctrl.params.gains.out_max)
         self.state = S.DISARMED
         self.since_s = 0.0
         self.sticks = RcCommand()
@@ -455,23 +459,22 @@ class Supervisor:
         est = inp.estimate
         assert self.alt_setpoint_m is not None
         if est.sonar_status is SonarStatus.REACQUIRED and self._prev_alt_m is not None:
-            # Not a move of the vehicle: the estimator re-based on another surface below (past
-            # a table's edge, or back from a drift). Held as it comes, the step is an error of
-            # up to a table's height: the vehicle dives for the tabletop it just left. As
-            # ArduCopter's surface tracking resets its target on a rangefinder step, the hold
-            # keeps the height it flies at, measured from the new surface.
+            # The estimator re-based on another surface (past a table's edge, or back from a
+            # drift), not a move: held as it comes, the vehicle dives for the table it left. As
+            # ArduCopter's surface tracking does, the hold keeps its height over the new one.
             jump = est.alt_m - self._prev_alt_m
             self.alt_ctrl.surface_changed(jump)
             self.alt_setpoint_m += jump
             if self.alt_target_m is not None:
                 self.alt_target_m += jump
-        # the controller's setpoint profile makes the move (at the asked rate, braking before
-        # the target): a ramp that stops dead at the target overshoots it
+        # the controller's profile makes the move: a ramp stopping dead would overshoot
         if self.alt_target_m is not None:
             self.alt_setpoint_m = self.alt_target_m
         floor = self.on_floor(est.alt_m) and self.alt_setpoint_m <= est.alt_m
+        sink = blind_sink_limit(est.alt_m - self.rest_alt_m, est.vel_mps, self._blind)
         self.alt = self.alt_ctrl.update(self.alt_setpoint_m, est, inp.roll_rad, inp.pitch_rad,
-                                        inp.dt_s, on_floor=floor, rate_mps=self.alt_rate_mps)
+                                        inp.dt_s, on_floor=floor, rate_mps=self.alt_rate_mps,
+                                        sink_limit_mps2=sink)
         blocked = self.alt_ctrl.blocked_climb_s
         if blocked >= self.p.blocked_climb_s and self.state is S.HOLD:
             if blocked - inp.dt_s < self.p.blocked_climb_s:
