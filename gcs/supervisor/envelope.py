@@ -76,6 +76,13 @@ def blind_sink_limit(height_m: float, climb_mps: float, blind: BlindFlight) -> f
 
 def _blind_limit(height_m: float, climb_mps: float, blind: BlindFlight) -> float:
     v, max_mps2 = blind.touchdown_mps, blind.max_mps2
+    h, w = height_m, climb_mps
+    if h > 0.0 and w * w < v * v:
+        # A steady hold's case in closed form: the limit of a fall that meets the floor
+        # within blind_s is where √(w² + 2·a·h) = v; a larger a only meets it sooner
+        a = (v * v - w * w) / (2.0 * h)
+        if a < max_mps2 and (w + math.sqrt(w * w + 2.0 * a * h)) / a <= blind.blind_s:
+            return a
     if blind_touchdown(height_m, climb_mps, max_mps2, blind) <= v:
         return math.inf
     lo, hi = 0.0, max_mps2
