@@ -58,7 +58,8 @@ class TeamPort:
         return self.team.check()
 
     def count(self, vehicle: int, p: RadiationMapperParams) -> Count:
-        return count_on_the_move(self.team, self.team.crafts[vehicle], p)
+        return count_on_the_move(self.team, self.team.crafts[vehicle], p,
+                                 lambda: self.off_mission(vehicle) is not None)
 
     def off_mission(self, vehicle: int) -> str | None:
         return off_mission(self.team.crafts[vehicle].snapshot(), self.team.elapsed_s())
@@ -66,4 +67,4 @@ class TeamPort:
     def fly_to_sample(self, vehicle: int, target_n: Vec3, p: RadiationMapperParams,
                       count_s: float, timeout_s: float) -> bool:
         return fly_to_sample(self.team, self.team.crafts[vehicle], target_n, p, count_s,
-                             timeout_s)
+                             timeout_s, lambda: self.off_mission(vehicle) is not None)

@@ -5,6 +5,7 @@ count is attributed (the radiation loop's `fly_to_sample` and `count` on a `Team
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -31,9 +32,14 @@ SAMPLE_SPEED_WINDOW_S = 0.25
 SAMPLE_POLL_S = 0.05  # station time: the same sampling however fast the SITL runs
 
 
+def _flying() -> bool:
+    return False
+
+
 def fly_to_sample(f: Team, craft: Craft, target: Vec3, p: RadiationMapperParams,
-                   count_s: float, timeout_s: float) -> bool:
-    """Fly through `target` until counting there should start; False on timeout.
+                   count_s: float, timeout_s: float, off: Callable[[], bool] = _flying) -> bool:
+    """Fly through `target` until counting there should start; False on timeout, or as soon
+    as `off` says the vehicle left the mission (a failsafe's LAND): the loop then says why.
 
     A reading is attributed to where the vehicle was while counting (see `count_on_the_move`),
     so it need not stop at the set position: the mapper is told where each sample was taken.
@@ -66,15 +72,17 @@ def fly_to_sample(f: Team, craft: Craft, target: Vec3, p: RadiationMapperParams,
         if (dist <= reach or (closest <= SAMPLE_PASS_M and dist > closest + SAMPLE_PASSED_M)
                 or (dist <= short_m and speed <= SAMPLE_STILL_MPS)):
             return True
-        if now - start >= timeout_s:
+        if now - start >= timeout_s or off():
             return False
         f.clock.sleep_until(now + SAMPLE_POLL_S)
 
 
-def count_on_the_move(f: Team, craft: Craft, p: RadiationMapperParams) -> Count:
+def count_on_the_move(f: Team, craft: Craft, p: RadiationMapperParams,
+                      off: Callable[[], bool] = _flying) -> Count:
     """Integrate the detector from now: mean counts/s, seconds counted, where it counted.
 
-    Counting stops at `p.dwell_s`, or once `p.target_counts` are in (the detector reports
+    Counting stops at `p.dwell_s`, once `off` says the vehicle left the mission, or once
+    `p.target_counts` are in (the detector reports
     counts/s over windows of `p.detector_window_s`). The vehicle may be moving: each report is
     attributed to the mean motion-capture position over its own window, and the reading to the
     mean of those, not to one look at the end (near a source the rate changes by several per
@@ -89,6 +97,8 @@ def count_on_the_move(f: Team, craft: Craft, p: RadiationMapperParams) -> Count:
         got = [r.counts_per_s for r in craft.radiation_since(t0)]
         if got and p.target_counts > 0.0 and sum(got) * p.detector_window_s >= p.target_counts:
             break
+        if off():
+            break  # what it counted from here on would be the LAND's, or the floor's
         f.clock.sleep_until(f.clock.now_s() + SAMPLE_POLL_S)
     seen.append(craft.position_n())
     reports = craft.radiation_since(t0)
