@@ -83,6 +83,8 @@ class SupervisorParams:
     def __post_init__(self) -> None:
         if not 0.0 < self.degraded_after_s < self.lost_after_s:
             raise ValueError("need 0 < degraded_after_s < lost_after_s")
+        if min(self.blind_s, self.blind_steady_mps, self.blind_touchdown_mps) <= 0.0:
+            raise ValueError("blind_s, blind_steady_mps and blind_touchdown_mps must be > 0")
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
             if isinstance(v, float) and v < 0.0:

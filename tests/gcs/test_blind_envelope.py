@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
 from gcs.supervisor.envelope import BlindFlight, blind_sink_limit, blind_touchdown
+from gcs.supervisor.params import SupervisorParams
 from tests.gcs.test_supervisor import REST_M, Script
 
 BLIND = BlindFlight(blind_s=2.5, brake_mps2=1.0, touchdown_mps=0.8, steady_mps=0.25,
@@ -107,3 +109,10 @@ def test_a_hover_learned_too_high_keeps_the_integrator_s_trim_below_it() -> None
         limit = blind_sink_limit(1.4 - REST_M, 0.0, s.sup._blind)
         assert s.sup.alt is not None
         assert s.sup.alt.accel_cmd_mps2 == pytest.approx(floor_at - limit, abs=0.01)
+
+
+@pytest.mark.parametrize("field", ["blind_s", "blind_steady_mps", "blind_touchdown_mps"])
+def test_a_zero_blind_setting_is_refused(field: str) -> None:
+    zero: dict[str, Any] = {field: 0.0}
+    with pytest.raises(ValueError, match=field):
+        SupervisorParams(**zero)
