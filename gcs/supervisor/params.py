@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 from firmware_link.records import Dialect
 from gcs.supervisor.envelope import BlindFlight
+from gcs.supervisor.types import LinkHealth
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,6 +90,14 @@ class SupervisorParams:
             v = getattr(self, f.name)
             if isinstance(v, float) and v < 0.0:
                 raise ValueError(f"{f.name} must be >= 0, got {v}")
+
+    def link_health(self, frame_age_s: float) -> LinkHealth:
+        """What a silence of `frame_age_s` since the vehicle's last frame means (see above)."""
+        if frame_age_s > self.lost_after_s:
+            return LinkHealth.LOST
+        if frame_age_s > self.degraded_after_s:
+            return LinkHealth.DEGRADED
+        return LinkHealth.OK
 
     def blind(self, max_mps2: float) -> BlindFlight:
         """The blind-flight envelope, for a hold that asks at most `max_mps2`."""

@@ -150,7 +150,7 @@ class Supervisor:
         self._actions, self._notes, self._transitions = [], [], []
         for intent in inp.intents:
             self._apply(intent, inp)
-        self._link = self._health(inp)
+        self._link = self.p.link_health(inp.vehicle.frame_age_s)
         self._watch_link(inp)
         if self._link is not LinkHealth.LOST:
             self._watch_vehicle(inp)
@@ -166,14 +166,6 @@ class Supervisor:
             throttle_gate_us=self.gate_us if self.state is S.MANUAL else None,
             command_acc_mps2=None if command is None or self.state is not S.HOLD else
             self.alt_ctrl.accel_for_throttle(command.throttle_us, inp.roll_rad, inp.pitch_rad))
-
-    def _health(self, inp: TickIn) -> LinkHealth:
-        age = inp.vehicle.frame_age_s
-        if age > self.p.lost_after_s:
-            return LinkHealth.LOST
-        if age > self.p.degraded_after_s:
-            return LinkHealth.DEGRADED
-        return LinkHealth.OK
 
     # ------------------------------------------------------------------ intents
     def _apply(self, it: Intent, inp: TickIn) -> None:
