@@ -82,8 +82,8 @@ def count_on_the_move(f: Team, craft: Craft, p: RadiationMapperParams,
     """Integrate the detector from now: mean counts/s, seconds counted, where it counted.
 
     Counting stops at `p.dwell_s`, once `off` says the vehicle left the mission, or once
-    `p.target_counts` are in (the detector reports
-    counts/s over windows of `p.detector_window_s`). The vehicle may be moving: each report is
+    `p.target_counts` are in (the detector reports counts/s over windows of
+    `p.detector_window_s`). The vehicle may be moving: each report is
     attributed to the mean motion-capture position over its own window, and the reading to the
     mean of those, not to one look at the end (near a source the rate changes by several per
     cent per centimetre).

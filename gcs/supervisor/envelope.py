@@ -66,12 +66,11 @@ def blind_sink_limit(height_m: float, climb_mps: float, blind: BlindFlight) -> f
     that demanded a climb would turn a wrong estimate (a carpet's late echo) into one."""
     if not math.isfinite(blind.touchdown_mps):
         return math.inf
-    max_mps2 = blind.max_mps2
     limit = _blind_limit(height_m, climb_mps, blind)
     opening = (abs(climb_mps) - blind.steady_mps) / blind.steady_mps
     if opening <= 0.0 or not math.isfinite(limit):
         return limit
-    return math.inf if opening >= 1.0 else limit + opening * (max_mps2 - limit)
+    return math.inf if opening >= 1.0 else limit + opening * (blind.max_mps2 - limit)
 
 
 def _blind_limit(height_m: float, climb_mps: float, blind: BlindFlight) -> float:
@@ -79,9 +78,10 @@ def _blind_limit(height_m: float, climb_mps: float, blind: BlindFlight) -> float
     h, w = height_m, climb_mps
     if h > 0.0 and w * w < v * v:
         # A steady hold's case in closed form: the limit of a fall that meets the floor
-        # within blind_s is where √(w² + 2·a·h) = v; a larger a only meets it sooner
+        # within blind_s is where √(w² + 2·a·h) = v, which it then does after (w + v)/a; a
+        # larger a only meets it sooner
         a = (v * v - w * w) / (2.0 * h)
-        if a < max_mps2 and (w + math.sqrt(w * w + 2.0 * a * h)) / a <= blind.blind_s:
+        if a < max_mps2 and (w + v) / a <= blind.blind_s:
             return a
     if blind_touchdown(height_m, climb_mps, max_mps2, blind) <= v:
         return math.inf
