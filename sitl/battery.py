@@ -31,7 +31,9 @@ _OCV_SOC = tuple(s for s, _ in _OCV_TABLE)
 _OCV_V = tuple(v for _, v in _OCV_TABLE)
 
 
-@dataclass(frozen=True, slots=True)
+# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
+# field) costs about three times a plain one's. Nothing changes one once built.
+@dataclass(slots=True)
 class BatteryState:
     """What a power module reports."""
 

@@ -12,7 +12,9 @@ RATE_MAX_RADS = math.radians(180.0)  # ANGLE_RATE_MAX of 3.2.1 (18000 cdeg/s)
 YAW_OUT_MAX = 0.4  # yaw authority kept below roll/pitch, as the motors' yaw headroom
 
 
-@dataclass(frozen=True)
+# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
+# field) costs about three times a plain one's. Nothing changes one once built.
+@dataclass(slots=True)
 class AttitudeOutput:
     """Normalised roll, pitch, yaw demands (±1) and the rate targets behind them."""
 

@@ -31,7 +31,9 @@ def isa_altitude_m(pressure_pa: float) -> float:
     return (1.0 - (pressure_pa / _P0_PA) ** (1.0 / _EXP)) / _K
 
 
-@dataclass(frozen=True, slots=True)
+# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
+# field) costs about three times a plain one's. Nothing changes one once built.
+@dataclass(slots=True)
 class BaroSample:
     """One barometer reading."""
 

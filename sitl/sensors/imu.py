@@ -24,7 +24,9 @@ Counts3 = tuple[int, int, int]
 _FULL_SCALE = 32768
 
 
-@dataclass(frozen=True, slots=True)
+# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
+# field) costs about three times a plain one's. Nothing changes one once built.
+@dataclass(slots=True)
 class ImuSample:
     """One IMU reading: SI values are the counts times the LSB (quantised, saturated)."""
 

@@ -53,7 +53,9 @@ FACING_AXIS_B: dict[ProximityFacing, Vec3] = {
 }
 
 
-@dataclass(frozen=True, slots=True)
+# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
+# field) costs about three times a plain one's. Nothing changes one once built.
+@dataclass(slots=True)
 class ProximitySample:
     """One IR reading; distance_m is None when nothing is inside the cone and range."""
 

@@ -20,7 +20,9 @@ from sitl.sensor_params import SonarParams
 from sitl.world import FloorMaterial
 
 
-@dataclass(frozen=True, slots=True)
+# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
+# field) costs about three times a plain one's. Nothing changes one once built.
+@dataclass(slots=True)
 class SonarSample:
     """A sonar reading; distance_m is 0 when not valid."""
 
