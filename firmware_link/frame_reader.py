@@ -19,7 +19,6 @@ frame by frame on real SITL traffic cut and corrupted at random.
 from __future__ import annotations
 
 import struct
-from collections.abc import Callable
 from typing import Any, cast
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
@@ -32,14 +31,13 @@ except ImportError:  # pymavlink's own decode checks the CRC instead (slower, sa
 _V1, _V2 = mavlink.PROTOCOL_MARKER_V1, mavlink.PROTOCOL_MARKER_V2
 _SIGNED = mavlink.MAVLINK_IFLAG_SIGNED
 _SIGNATURE_LEN = mavlink.MAVLINK_SIGNATURE_BLOCK_LEN
-_CRC = struct.Struct("<H")
 _H1 = struct.Struct("<BBBBBB")
 _H2 = struct.Struct("<BBBBBBBHB")
 
 # (class, unpack, wire-order field names or, for a message with arrays, each field's name, first
 # value and count; the attributes its constructor sets; crc_extra; payload size)
 _Layout = tuple[str, ...] | tuple[tuple[str, int, int], ...]
-_Plain = tuple[type, Callable[[Any], tuple[Any, ...]], _Layout, bool, dict[str, Any], int, int]
+_Plain = tuple[type, struct.Struct, _Layout, bool, dict[str, Any], int, int]
 
 
 def _plain(cls: Any) -> _Plain | None:
@@ -61,7 +59,7 @@ def _plain(cls: Any) -> _Plain | None:
         return None
     if set(attrs) - set(cls.fieldnames) - _BOOKKEEPING:
         return None  # a constructor that does more than store its arguments
-    return (cls, cls.unpacker.unpack, layout, arrays, attrs, int(cls.crc_extra),
+    return (cls, cls.unpacker, layout, arrays, attrs, int(cls.crc_extra),
             int(cls.unpacker.size))
 
 
@@ -149,16 +147,17 @@ class FrameReader:
             plain = _PLAIN[msg_id] = None if cls is None else _plain(cls)
         if plain is None:
             return None
-        cls, unpack, layout, arrays, attrs, crc_extra, size = plain
-        crc = _CRC.unpack_from(frame, len(frame) - 2)[0]
+        cls, unpacker, layout, arrays, attrs, crc_extra, size = plain
+        crc = frame[-2] | frame[-1] << 8  # little-endian
         body = frame[1:-2]
         body.append(crc_extra)
-        if mcrf4xx(bytes(body), 0xFFFF) != crc:
+        if mcrf4xx(body, 0xFFFF) != crc:
             return None  # decode says why
-        payload = frame[header_len:-2]
-        if len(payload) < size:  # MAVLink 2 drops trailing zeros; MAVLink 1 has no extensions
-            payload.extend(bytes(size - len(payload)))
-        t = unpack(payload[:size])
+        missing = size - (len(frame) - header_len - 2)
+        if missing > 0:  # MAVLink 2 drops trailing zeros; MAVLink 1 has no extensions
+            t = unpacker.unpack(frame[header_len:-2] + bytes(missing))
+        else:
+            t = unpacker.unpack_from(frame, header_len)  # the payload's first `size` bytes
         d = attrs.copy()
         if arrays:
             for name, first, count in cast(tuple[tuple[str, int, int], ...], layout):

@@ -66,39 +66,57 @@ def _payload_fn(cls: type) -> Payload | None:
     return payload
 
 
+class _Kind:
+    """What framing a message class needs, worked out on its first frame."""
+
+    __slots__ = ("crc_extra", "msg_id", "payload", "v1_base")
+
+    def __init__(self, cls: Any, payload: Payload, v1_base: int | None) -> None:
+        self.payload = payload
+        self.msg_id: int = cls.id
+        self.crc_extra = bytes((cls.crc_extra,))  # the checksum's last byte
+        self.v1_base = v1_base  # MAVLink 1 base payload bytes (None: the whole payload)
+
+
 class FramePacker:
     """Packs unsigned frames for one sender; the sequence number is the caller's."""
 
     def __init__(self, v1_base_bytes: dict[int, int]) -> None:
         self._v1_base = v1_base_bytes
-        self._payload: dict[type, Payload | None] = {}
+        self._kinds: dict[type, _Kind | None] = {}
 
     @staticmethod
     def available() -> bool:
         """Whether the checksum routine is there (else callers use pymavlink)."""
         return mcrf4xx is not None
 
+    def _kind(self, cls: Any) -> _Kind | None:
+        fn = _payload_fn(cls)
+        kind = None if fn is None else _Kind(cls, fn, self._v1_base.get(cls.id))
+        self._kinds[cls] = kind
+        return kind
+
     def frame(self, msg: Any, seq: int, sysid: int, compid: int, mavlink1: bool) -> bytes | None:
         """The frame of `msg`, or None for a message this packer does not handle."""
         cls = type(msg)
-        fn = self._payload.get(cls, ...)
-        if fn is ...:
-            fn = self._payload[cls] = _payload_fn(cls)
-        if fn is None or mcrf4xx is None:
+        kind = self._kinds.get(cls, ...)
+        if kind is ...:
+            kind = self._kind(cls)
+        if kind is None or mcrf4xx is None:
             return None
-        payload = fn(msg)
-        msg_id = cls.id
+        payload = kind.payload(msg)
+        msg_id = kind.msg_id
         if mavlink1:
             if msg_id > 255:
                 return None
-            payload = payload[: self._v1_base.get(msg_id, len(payload))]
+            if kind.v1_base is not None:
+                payload = payload[: kind.v1_base]
             header = _V1.pack(0xFE, len(payload), seq, sysid, compid, msg_id)
         else:
-            n = len(payload)
-            while n > 1 and payload[n - 1] == 0:
-                n -= 1
-            payload = payload[:n]
-            header = _V2.pack(0xFD, n, 0, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16)
+            payload = payload.rstrip(b"\0") or payload[:1]  # trailing zeros, one byte kept
+            header = _V2.pack(0xFD, len(payload), 0, 0, seq, sysid, compid, msg_id & 0xFFFF,
+                              msg_id >> 16)
         body = header + payload
-        crc = mcrf4xx(body[1:] + bytes((cls.crc_extra,)), 0xFFFF)
+        # CRC-16/MCRF4XX over the frame after its magic byte, then CRC_EXTRA (the CRC carried on)
+        crc = mcrf4xx(kind.crc_extra, mcrf4xx(body[1:], 0xFFFF))
         return body + _CRC.pack(crc)

@@ -172,6 +172,9 @@ class StreamSchedule:
         self._all_params = list(self._group_param.values()) + ([extra] if extra in params else [])
         self._periods: dict[str, float] = {}
         self._periods_key: tuple[int, bool] | None = None
+        # the earliest time a message is due (-inf: work it out again); most ticks nothing is,
+        # and `due` then returns at once instead of looking at every message
+        self._earliest_s = -math.inf
 
     def streamable(self, name: str) -> bool:
         """Whether `name` is a message this link can stream."""
@@ -191,6 +194,7 @@ class StreamSchedule:
         for g in groups:
             for m in self._groups[g]:
                 self._next_due.pop(m, None)
+        self._earliest_s = -math.inf
 
     def set_interval(self, name: str, interval_us: float) -> bool:
         """SET_MESSAGE_INTERVAL: -1 disables, 0 restores the group rate; False if unknown."""
@@ -204,6 +208,7 @@ class StreamSchedule:
             self._override_s[name] = max(1.0 / MAX_RATE_HZ, interval_us * 1e-6)
         self._next_due.pop(name, None)
         self._periods_key = None
+        self._earliest_s = -math.inf
         return True
 
     def interval_s(self, name: str, slowed: bool = False) -> float | None:
@@ -232,6 +237,7 @@ class StreamSchedule:
             if period is not None:
                 self._periods[name] = period
         self._periods_key = (self.params.version, slowed)
+        self._earliest_s = -math.inf
 
     def due(self, t_s: float, params_pending: bool = False) -> list[str]:
         """Messages to send at `t_s` (each at most once per call)."""
@@ -239,6 +245,8 @@ class StreamSchedule:
         slowed = self._apm25 and params_pending
         if self._periods_key != (self.params.version, slowed):
             self._refresh_periods(slowed)
+        if t_s + 1e-9 < self._earliest_s:
+            return out
         for name, period in self._periods.items():
             nxt = self._next_due.get(name)
             if nxt is None or t_s + 1e-9 >= nxt:
@@ -246,4 +254,6 @@ class StreamSchedule:
                 # keep the phase, but never try to catch up a backlog
                 base = t_s if nxt is None or t_s - nxt > period else nxt
                 self._next_due[name] = base + period
+        due = self._next_due
+        self._earliest_s = min((due[name] for name in self._periods), default=math.inf)
         return out
