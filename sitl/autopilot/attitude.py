@@ -73,7 +73,9 @@ class AttitudeController:
             self.yaw_target_rad = _wrap_pi(yaw + yaw_err)
 
         def lim(x: float) -> float:
-            return min(RATE_MAX_RADS, max(-RATE_MAX_RADS, x))
+            # min(RATE_MAX_RADS, max(-RATE_MAX_RADS, x)) without the calls (same result)
+            x = x if x > -RATE_MAX_RADS else -RATE_MAX_RADS
+            return x if x < RATE_MAX_RADS else RATE_MAX_RADS
 
         # Euler-angle rates to body rates (small-angle exact for roll/pitch, yaw via tilt)
         rr_e = lim(g.stb_rll_p * (target_roll_rad - roll))
@@ -88,9 +90,13 @@ class AttitudeController:
         out_r = self._roll.update(p_t - gx, dt_s, limit_i=saturated).total
         out_p = self._pitch.update(q_t - gy, dt_s, limit_i=saturated).total
         out_y = self._yaw.update(r_t - gz, dt_s, limit_i=saturated).total
+        # min(hi, max(-hi, out)) each, without the calls (same result)
+        out_r = out_r if out_r > -1.0 else -1.0
+        out_p = out_p if out_p > -1.0 else -1.0
+        out_y = out_y if out_y > -YAW_OUT_MAX else -YAW_OUT_MAX
         return AttitudeOutput(
-            roll=min(1.0, max(-1.0, out_r)),
-            pitch=min(1.0, max(-1.0, out_p)),
-            yaw=min(YAW_OUT_MAX, max(-YAW_OUT_MAX, out_y)),
+            roll=out_r if out_r < 1.0 else 1.0,
+            pitch=out_p if out_p < 1.0 else 1.0,
+            yaw=out_y if out_y < YAW_OUT_MAX else YAW_OUT_MAX,
             rate_target_rads=(p_t, q_t, r_t),
         )

@@ -119,7 +119,9 @@ class Autopilot:
         """Throttle channel as control_in, 0..1000, with the bottom dead zone."""
         pwm = self.radio.channel(2)
         dz = self._dz_us[2]
-        return min(1000.0, max(0.0, (pwm - 1000.0 - dz) * 1000.0 / (1000.0 - dz)))
+        c = (pwm - 1000.0 - dz) * 1000.0 / (1000.0 - dz)  # min(1000, max(0, c)), no calls
+        c = c if c > 0.0 else 0.0
+        return c if c < 1000.0 else 1000.0
 
     def _centred(self, ch: int) -> float:
         """A centred stick past its dead zone, -1..1."""

@@ -57,5 +57,9 @@ def mix_plus(
     if thr + lo < spin_min:
         thr = spin_min - lo
         limit_low = True
-    out = [min(1.0, max(spin_min, thr + d)) for d in deltas]
+    out = []
+    for d in deltas:  # min(1.0, max(spin_min, thr + d)) without the calls (same result)
+        m = thr + d
+        m = m if m > spin_min else spin_min
+        out.append(m if m < 1.0 else 1.0)
     return MixerOutput((out[0], out[1], out[2], out[3]), limit_high, limit_low)

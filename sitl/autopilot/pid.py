@@ -63,7 +63,10 @@ class Pid:
         if dt_s > 0.0 and g.ki > 0.0:
             grow = error * g.ki * dt_s
             if not (limit_i and grow * self._integrator > 0.0):
-                self._integrator = min(g.imax, max(-g.imax, self._integrator + grow))
+                # min(imax, max(-imax, i)) without the calls (the hot path: same result)
+                i = self._integrator + grow
+                i = i if i > -g.imax else -g.imax
+                self._integrator = i if i < g.imax else g.imax
         d = 0.0
         if g.kd > 0.0 and dt_s > 0.0:
             if self._last_error is not None:
