@@ -9,7 +9,7 @@ truth, which the fault does not touch.
 Prints per profile: the worst deviation from the setpoint during the loss (median, worst,
 flights over 0.1 m), the hold's RMS over the same seconds, the flights that ended early.
 
-    .venv/bin/python bench/lossy_hold.py [--seeds 1-20] [--profiles apm25,copter4]
+    .venv/bin/python bench/lossy_hold.py [--seeds 1-60] [--profiles apm25,copter4]
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ def fly_lossy(profile: str, seed: int) -> tuple[float, float, str]:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", default="1-20", help="SITL seeds, FIRST-LAST (default 1-20)")
+    ap.add_argument("--seeds", default="1-60", help="SITL seeds, FIRST-LAST (default 1-60)")
     ap.add_argument("--profiles", default="apm25,copter4", help="comma-separated profiles")
     ap.add_argument("--verbose", action="store_true", help="a line per flight")
     args = ap.parse_args()

@@ -2,9 +2,10 @@
 a third-order complementary filter (as APM's inertial navigation) and a Kalman filter that also
 fuses the barometer to bridge the sonar's gaps over carpet."""
 
-from gcs.estimation.base import AltEstimate, AltEstimator, EstimatorCounts, SonarStatus
+from gcs.estimation.base import AltEstimator
 from gcs.estimation.complementary import ComplementaryEstimator
 from gcs.estimation.dead_reckoning import DeadReckoningEstimator
+from gcs.estimation.estimate import AltEstimate, EstimatorCounts, SonarStatus
 from gcs.estimation.inputs import (
     GRAVITY_MPS2,
     baro_altitude_m,

@@ -1,13 +1,12 @@
-"""What every altitude estimator shares: the estimate record, the driver, sonar gating."""
+"""What every altitude estimator shares: the driver, sonar gating."""
 
 from __future__ import annotations
 
-import enum
 import math
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from firmware_link.records import Attitude, Imu, Rangefinder
 from gcs.estimation.catch_up import CatchUp, TickInputs, average_imu
@@ -17,54 +16,10 @@ from gcs.estimation.control import (
     control_predict,
     control_start,
 )
+from gcs.estimation.estimate import AltEstimate, EstimatorCounts, SonarStatus
 from gcs.estimation.inputs import line_at, sonar_altitude_m, vertical_accel_up_mps2
 from gcs.estimation.params import EstimatorParams
 from gcs.estimation.repeat_motion import RepeatMotion
-
-
-class SonarStatus(enum.Enum):
-    """What happened to the sonar on this step."""
-
-    NONE = "none"  # no new reading
-    USED = "used"
-    GROUND = "ground"  # zero reading near the floor, used as altitude 0
-    INVALID = "invalid"  # out of range / zero in the air
-    DUPLICATE = "duplicate"  # the stream repeating a reading the sensor has not replaced
-    REJECTED = "rejected"  # failed the innovation gate (outlier, late echo)
-    # consistent readings after rejections (estimate reset to them), or one reading that moved
-    # the estimate by a surface step (accepted through a gate widened by a long coast)
-    REACQUIRED = "reacquired"
-
-
-@dataclass(frozen=True, slots=True)
-class EstimatorCounts:
-    """What the estimator set aside over a flight, so that a summary can say so."""
-
-    sonar_rejected: int  # readings that failed the innovation gate
-    late_bursts: int  # telemetry bursts integrated again at their samples' own times
-    imu_repeats: int  # IMU samples the link delivered twice (integrated once)
-    implausible_times: int  # samples stamped ahead of the station's clock (not learned from)
-
-
-@dataclass(frozen=True, slots=True)
-class AltEstimate:
-    """Altitude estimate (up positive) and its diagnostics."""
-
-    t_s: float
-    alt_m: float
-    vel_mps: float
-    acc_mps2: float  # bias-corrected upward acceleration used this step
-    bias_mps2: float  # estimated accelerometer bias (vertical)
-    sonar_used: bool
-    sonar_status: SonarStatus
-    innovation_m: float  # sonar altitude minus predicted altitude (0 when none)
-    sonar_age_s: float  # time since the last accepted sonar reading (inf before any)
-    coasting: bool  # no accepted sonar for longer than stale_after_s
-    alt_sigma_m: float  # the filter's own standard deviation, nan when it has none
-    rejected_total: int
-    # what the altitude hold flies on (gcs/estimation/control.py); None: alt_m and vel_mps
-    control_alt_m: float | None = None
-    control_vel_mps: float | None = None
 
 
 class AltEstimator(ABC):
@@ -83,6 +38,7 @@ class AltEstimator(ABC):
         self._acc_up = 0.0
         self._imu_t_s = -math.inf
         self._last_sonar_t_s = -math.inf
+        self._sonar_heard_s = -math.inf  # the last sonar record of any kind
         self._last_distance: float | None = None
         self._last_new_t_s = -math.inf  # tick of the last reading counted as new
         self._last_new_rx_s = -math.inf  # its message's receive stamp
@@ -108,8 +64,7 @@ class AltEstimator(ABC):
         # the repeat test that, unlike the hold's, a rerun with other gains leaves as it was
         self._twin = control_start(0.0, 0.0, 0.1**2)
         self._command_acc: float | None = None
-        self._command_lagged = 0.0
-        self._command_residual = 0.0
+        self._command_lagged = self._command_residual = 0.0
 
     @abstractmethod
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
@@ -178,6 +133,7 @@ class AltEstimator(ABC):
                 t_s - self._reject_run_start_s >= p.reacquire_min_s)
             tail = [z for _, z in self._rejected][-p.reacquire_count:] if long_run else []
             status, innovation = self._sonar(sonar, t_s, alt_before)
+            self._sonar_heard_s = t_s
             if status is SonarStatus.USED and self._leapt_onto(tail, alt_before):
                 status = SonarStatus.REACQUIRED
         if at_rest and self._state()[0] < p.ground_alt_m:
@@ -195,8 +151,13 @@ class AltEstimator(ABC):
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
         ctl = self._control
-        if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or age > p.stale_after_s
-                or at_rest or not self._initialised):
+        # A sensor that kept sending what the estimate did not take (a carpet's repeats while
+        # an echo is out, late echoes the gate refused) is the estimator's to bridge, on its
+        # barometer too; a stream the link lost whole leaves the hold on its command a while.
+        heard = self._sonar_heard_s > self._last_sonar_t_s
+        if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or at_rest
+                or age > (p.stale_after_s if heard else p.control_coast_s)
+                or not self._initialised):
             control_follow(ctl, alt, vel, sigma)
             control_follow(self._twin, alt, vel, sigma)
         elif status is SonarStatus.USED:

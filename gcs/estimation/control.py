@@ -10,9 +10,11 @@ filter halves the wander but costs the coasting, the bias and the carpet's gatin
 So the hold gets its own two-state filter beside the estimator: it propagates on the
 estimator's bias-corrected acceleration and takes exactly the readings the estimator accepted
 (moved to the present for a late echo), with a process noise that puts its bandwidth well
-above the loop's. Whenever the estimator has no fresh reading to offer (coasting through a
-gap), re-based on another surface, or stands on the floor, the control altitude is the
-estimator's: it never second-guesses the gate.
+above the loop's. Whenever the estimator has had no reading to offer for a while (coasting
+through a gap longer than `control_coast_s`), re-based on another surface, or stands on the
+floor, the control altitude is the estimator's: it never second-guesses the gate. Through a
+shorter gap it coasts on the command the station sent, which knows better than a few aliased
+accelerometer samples which way the vehicle is being pushed.
 """
 
 from __future__ import annotations

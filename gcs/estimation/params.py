@@ -106,6 +106,16 @@ class EstimatorParams:
     # station assumes, 1.43 -> 1.36 cm. 0 turns it off.
     command_blend_tc_s: float = 1.0
     command_lag_s: float = 0.05  # the rotors' first-order time constant, as the station assumes
+    # When the link loses the sonar's records outright (no repeat, no refusal: nothing), the
+    # hold's filter coasts on the command this long before it takes the estimator's state. On
+    # 3.2.1's 25 Hz RAW_IMU a few samples of aliased vibration can read +0.5 m/s² against a
+    # vehicle the hold pushes down: taken at stale_after_s, the estimator's velocity had the
+    # wrong sign and the hold pushed on into the floor (30 % lossy link, lockstep apm25 seed
+    # 52: 11.9 cm low). bench/lossy_hold.py, seeds 1-60: worst 11.9 -> 8.2 cm, none over
+    # 0.1 m; 1.0 s gave the same. Over carpet the sensor keeps sending (repeats while an echo
+    # is out) and the estimator's barometer bridges better: coasting there too cost 1-3 cm of
+    # the carpet campaign's worst RMS, so it does not.
+    control_coast_s: float = 0.6
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.sonar_min_m < self.sonar_max_m:
@@ -118,7 +128,7 @@ class EstimatorParams:
                 raise ValueError(f"{name} must be > 0")
         for name in ("command_blend_tc_s", "command_lag_s", "sonar_resolution_m",
                      "sonar_repeat_s", "sonar_stale_move_m", "sonar_stale_drift_mps",
-                     "sonar_doubt_s"):
+                     "sonar_doubt_s", "control_coast_s"):
             if getattr(self, name) < 0.0:
                 raise ValueError(f"{name} must be >= 0")
         if self.reacquire_count < 2 or self.reacquire_track_count < 3:
