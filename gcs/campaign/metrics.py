@@ -31,6 +31,7 @@ NUMERIC_METRICS: dict[str, str] = {
     "steps": "mission: planner steps",
     "path_length_m": "mission: length of the path flown, m",
     "iou": "mission: radiation map's overlap with the true contour",
+    "samples": "mission: radiation samples taken",
     "sim_s": "simulated time of the run, s",
     "cpu_s": "CPU time of the run, s",
     "wall_s": "wall time of the run, s",
@@ -68,7 +69,8 @@ def flown_row(run_id: str, values: dict[str, Any], summary: dict[str, Any]) -> d
 
 MISSION_KEYS = {"collisions": "collisions", "min_clearance_m": "truth_min_clearance_m",
                 "goal_error_m": "goal_error_m", "mission_s": "duration_s", "steps": "steps",
-                "path_length_m": "path_length_m", "iou": "iou", "sim_s": "duration_s"}
+                "path_length_m": "path_length_m", "iou": "iou", "samples": "samples",
+                "sim_s": "duration_s"}
 
 
 def mission_row(run_id: str, values: dict[str, Any], report: dict[str, Any],

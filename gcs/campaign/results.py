@@ -103,13 +103,15 @@ def summary_table(rows: Sequence[dict[str, Any]], axes: Sequence[str],
 
 def mission_summary_table(rows: Sequence[dict[str, Any]], axes: Sequence[str]) -> str:
     """Mission runs grouped by every axis but the seed: how many met their goal, the contacts
-    (over every run that measured them) and the closest pass, the flight time and goal error."""
+    (over every run that measured them) and the closest pass, the flight time, the goal error
+    and, for a mapping mission, the map's IoU (median and worst)."""
     group_axes = [a for a in axes if a != "seed"]
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
     for r in rows:
         groups.setdefault(tuple(r.get(a) for a in group_axes), []).append(r)
     head = [*group_axes, "runs", "ok", "failed", "scored", "contacts", "runs touching",
-            "clearance median cm", "closest", "flight s median", "longest", "goal error cm"]
+            "clearance median cm", "closest", "flight s median", "longest", "goal error cm",
+            "IoU median", "worst"]
     lines = [head]
     for key in sorted(groups, key=lambda k: tuple(str(x) for x in k)):
         rs = groups[key]
@@ -129,7 +131,8 @@ def mission_summary_table(rows: Sequence[dict[str, Any]], axes: Sequence[str]) -
                       stat(vals("min_clearance_m"), np.median, 100.0),
                       stat(vals("min_clearance_m"), min, 100.0),
                       stat(vals("mission_s"), np.median), stat(vals("mission_s"), max),
-                      stat(vals("goal_error_m"), np.median, 100.0)])
+                      stat(vals("goal_error_m"), np.median, 100.0),
+                      stat(vals("iou"), np.median), stat(vals("iou"), min)])
     widths = [max(len(row[i]) for row in lines) for i in range(len(head))]
     return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(row, widths, strict=True))
                      for row in lines)

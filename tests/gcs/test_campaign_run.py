@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from gcs.campaign.results import mission_summary_table
 from gcs.campaign.run import fly_run, make_run
 from gcs.campaign.spec import BaseFlight
 
@@ -73,3 +74,12 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_flies_the_rest(tmp_path: Pat
     second = run_campaign(c, tmp_path / "out", InterruptedRay(finish=10), quiet=True)
     assert second.complete and (second.ran, second.skipped) == (3, 2)
     assert sorted(r["seed"] for r in read_results(second.results)) == [1, 2, 3, 4, 5]
+
+
+def test_a_mapping_missions_summary_gives_its_iou_median_and_worst() -> None:
+    rows = [{"seed": s, "status": "ok", "iou": iou, "collisions": 0.0, "mission_s": 250.0}
+            for s, iou in ((1, 0.96), (2, 0.94), (3, 0.98))]
+    rows.append({"seed": 4, "status": "failed", "iou": None, "mission_s": 30.0})  # never scored
+    head, line = mission_summary_table(rows, ["seed"]).splitlines()
+    assert head.split()[-3:] == ["IoU", "median", "worst"]
+    assert line.split()[:3] == ["4", "3", "1"] and line.split()[-2:] == ["0.96", "0.94"]
