@@ -6,7 +6,7 @@ the start, and prints per leg: overshoot past the new spot (% of the leg), time 
 ±5 cm, the largest excursion off the line (east) and of the altitude. Floors from the mission
 issue: a 0.5 m leg within ±5 cm in ≤ 2 s with ≤ 10 % overshoot; a 2 m leg in ≤ 4 s.
 
-    .venv/bin/python bench/position_legs.py [--seeds 1,2,3] [--legs 0.5,2.0]
+    .venv/bin/python bench/position_legs.py [--seeds 1-50] [--legs 0.5,2.0]
 """
 
 from __future__ import annotations
@@ -19,18 +19,20 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from open_loop import seed_range  # this directory, as the script runs
+
 from gcs.position_legs import fly_legs
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", default="1,2,3", help="SITL seeds, comma-separated")
+    ap.add_argument("--seeds", default="1-50", help="SITL seeds, FIRST-LAST (default 1-50)")
     ap.add_argument("--legs", default="0.5,2.0", help="leg lengths in metres, comma-separated")
     args = ap.parse_args()
-    seeds = [int(s) for s in args.seeds.split(",")]
+    seeds = seed_range(args.seeds)
     legs = tuple(float(x) for x in args.legs.split(","))
-    print(f"lockstep, seeds {seeds}, legs {legs} m north and south across the start, "
-          "band ±5 cm, 10 s each")
+    print(f"lockstep, seeds {seeds[0]}-{seeds[-1]}, legs {legs} m north and south across the "
+          "start, band ±5 cm, 10 s each")
     print(f"{'profile':8} {'leg m':>5} {'overshoot % med/max':>20} {'settle s med/max':>17} "
           f"{'cross cm':>8} {'alt dev cm':>10}")
     for profile in ("apm25", "copter4"):
