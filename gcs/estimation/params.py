@@ -113,7 +113,7 @@ class EstimatorParams:
     # wrong sign and the hold pushed on into the floor (30 % lossy link, lockstep apm25 seed
     # 52: 11.9 cm low). bench/lossy_hold.py, seeds 1-60: worst 11.9 -> 8.2 cm, none over
     # 0.1 m; 1.0 s gave the same. Over carpet the sensor keeps sending (repeats while an echo
-    # is out) and the estimator's barometer bridges better: coasting there too cost 1-3 cm of
+    # is out) and the estimator's barometer bridges better: coasting there too cost 2-3.5 cm of
     # the carpet campaign's worst RMS, so it does not.
     control_coast_s: float = 0.6
 

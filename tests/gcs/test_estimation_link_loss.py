@@ -1,6 +1,6 @@
 """The estimator on a lossy radio: a sonar reading after frames were lost is the sensor's
 latest, not a late echo; a velocity error of the estimator alone does not make the sonar's
-repeats look stale."""
+repeats look stale; through a gap the link left empty the hold's filter coasts on the command."""
 
 from __future__ import annotations
 
