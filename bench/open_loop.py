@@ -11,7 +11,7 @@ Prints per profile and fade: the peak height (median, worst, flights above setpo
 and the touchdown speed (median, worst, flights over 1.0 m/s: the slope of the last 0.25 s
 above the floor), and the flights that never came down.
 
-    .venv/bin/python bench/open_loop.py [--seeds 1-20] [--fade up,both]
+    .venv/bin/python bench/open_loop.py [--seeds 1-60] [--fade up,both]
 """
 
 from __future__ import annotations
@@ -82,7 +82,7 @@ def seed_range(text: str) -> list[int]:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", default="1-20", help="SITL seeds, FIRST-LAST (default 1-20)")
+    ap.add_argument("--seeds", default="1-60", help="SITL seeds, FIRST-LAST (default 1-60)")
     ap.add_argument("--fade", default="up,both", help="fades: up, both, down (comma-separated)")
     args = ap.parse_args()
     seeds = seed_range(args.seeds)
