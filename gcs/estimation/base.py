@@ -151,12 +151,15 @@ class AltEstimator(ABC):
         alt, vel, bias, sigma = self._state()
         age = t_s - self._last_sonar_t_s
         ctl = self._control
-        # A sensor that kept sending what the estimate did not take (a carpet's repeats while
-        # an echo is out, late echoes the gate refused) is the estimator's to bridge, on its
-        # barometer too; a stream the link lost whole leaves the hold on its command a while.
-        heard = self._sonar_heard_s > self._last_sonar_t_s
+        # No sonar record at all while the accelerometer's keep coming: the link lost them, and
+        # the hold coasts on its command a while. A sensor that kept sending what the estimate
+        # did not take (a carpet's repeats, refused late echoes) is the estimator's to bridge,
+        # on its barometer too; so is a stream that stopped whole (a vehicle fallen behind,
+        # whose burst the catch-up replays: a command it has not flown yet predicts nothing).
+        lost = (self._sonar_heard_s <= self._last_sonar_t_s
+                and t_s - self._imu_t_s < 0.5 * p.stale_after_s)
         if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or at_rest
-                or age > (p.stale_after_s if heard else p.control_coast_s)
+                or age > (p.control_coast_s if lost else p.stale_after_s)
                 or not self._initialised):
             control_follow(ctl, alt, vel, sigma)
             control_follow(self._twin, alt, vel, sigma)

@@ -63,7 +63,8 @@ def test_repeats_are_stale_only_when_both_velocities_say_the_vehicle_moved() -> 
     assert copy.moved_m() < m.moved_m()
 
 
-def _pushed_down_in_a_gap(sonar_in_gap: Rangefinder | None) -> tuple[float, float]:
+def _pushed_down_in_a_gap(sonar_in_gap: Rangefinder | None,
+                          imu_in_gap: bool = True) -> tuple[float, float]:
     """Hover at 1.0 m, then 0.35 s in which the station asks -0.4 m/s² and the few IMU samples
     that arrive (every other tick) read +0.5 m/s², vibration aliased by a 25 Hz RAW_IMU.
     (estimator's velocity, hold filter's velocity) at the end."""
@@ -76,7 +77,7 @@ def _pushed_down_in_a_gap(sonar_in_gap: Rangefinder | None) -> tuple[float, floa
     for k in range(400, 414):
         t = k * DT
         sonars = [] if sonar_in_gap is None else [replace(sonar_in_gap, t_s=t)]
-        out = est.update_tick(_imu(t, 0.5) if k % 2 else None, sonars, None, t,
+        out = est.update_tick(_imu(t, 0.5) if k % 2 and imu_in_gap else None, sonars, None, t,
                               command_acc_mps2=-0.4)
     assert out is not None and out.control_vel_mps is not None
     return out.vel_mps, out.control_vel_mps
@@ -96,4 +97,11 @@ def test_readings_the_gate_turned_down_leave_the_hold_on_the_estimators_state() 
     while an echo is out) are the estimator's to bridge, on its barometer too: past
     stale_after_s the hold flies the estimator's state, as before."""
     est_vel, hold_vel = _pushed_down_in_a_gap(Rangefinder(0.0, 1, 0.0, False, "RANGEFINDER"))
+    assert hold_vel == est_vel
+
+
+def test_a_stream_that_stopped_whole_leaves_the_hold_on_the_estimators_state() -> None:
+    """Nothing at all arrives (a vehicle or link fallen behind, whose burst comes later): the
+    vehicle has not flown the commands yet either, so the hold takes the estimator's state."""
+    est_vel, hold_vel = _pushed_down_in_a_gap(None, imu_in_gap=False)
     assert hold_vel == est_vel
