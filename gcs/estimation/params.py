@@ -106,8 +106,10 @@ class EstimatorParams:
     # station assumes, 1.43 -> 1.36 cm. 0 turns it off.
     command_blend_tc_s: float = 1.0
     command_lag_s: float = 0.05  # the rotors' first-order time constant, as the station assumes
-    # When the link loses the sonar's records outright (no repeat, no refusal: nothing), the
-    # hold's filter coasts on the command this long before it takes the estimator's state. On
+    # When the link loses the sonar's records outright (no repeat, no refusal: nothing, while
+    # the IMU's samples keep coming), the hold's filter coasts on the command this long before
+    # it takes the estimator's state (a stream that stopped whole hands over at
+    # stale_after_s: the vehicle that fell behind has not flown those commands yet). On
     # 3.2.1's 25 Hz RAW_IMU a few samples of aliased vibration can read +0.5 m/s² against a
     # vehicle the hold pushes down: taken at stale_after_s, the estimator's velocity had the
     # wrong sign and the hold pushed on into the floor (30 % lossy link, lockstep apm25 seed
