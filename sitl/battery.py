@@ -8,9 +8,9 @@ battery gives a lower voltage, and with it a lower maximum rotor speed and thrus
 from __future__ import annotations
 
 import bisect
-from dataclasses import dataclass
 
 from sitl.params import VehicleParams
+from sitl.tick_record import tick_record
 
 # (state of charge 0..1, open-circuit volts per cell), ascending in charge.
 _OCV_TABLE: tuple[tuple[float, float], ...] = (
@@ -31,9 +31,7 @@ _OCV_SOC = tuple(s for s, _ in _OCV_TABLE)
 _OCV_V = tuple(v for _, v in _OCV_TABLE)
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class BatteryState:
     """What a power module reports."""
 

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -24,6 +23,7 @@ from sitl.link.channel import Channel
 from sitl.link.handler import VehicleLink
 from sitl.link.view import GeoOrigin, VehicleView
 from sitl.sensors import MocapSample
+from sitl.tick_record import tick_record
 from sitl.vehicle_model import SimVehicle
 from sitl.world import World, WorldError
 
@@ -33,9 +33,7 @@ PROXIMITY_RATE_HZ = 10.0
 RADIATION_RATE_HZ = 5.0
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class MocapFrame:
     """A motion-capture pose of one vehicle, delivered at `delivered_t_s`."""
 

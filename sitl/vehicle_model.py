@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -32,14 +31,13 @@ from sitl.sensors.mocap import MocapModel, MocapSample
 from sitl.sensors.proximity import ProximityModel, ProximitySample
 from sitl.sensors.radiation import RadiationModel
 from sitl.sensors.sonar import SonarModel, SonarSample
+from sitl.tick_record import tick_record
 from sitl.world import FloorMaterial, World
 
 OTHER_VEHICLE = "vehicle"  # proximity target name for another vehicle's body
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class TruthState:
     """Ground truth (NED, FRD, q_nb = w, x, y, z); for evaluation, never for control."""
 

@@ -9,10 +9,10 @@ throttle_average, 4.x's MOT_HOVER_LEARN), which is what keeps the integrator sma
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from sitl.autopilot.gains import Gains
 from sitl.autopilot.pid import Pid, PidTerms
+from sitl.tick_record import tick_record
 
 ACCEL_Z_MAX_CMSS = 250.0  # target acceleration bound (PILOT_ACCEL_Z)
 ACCEL_FILT_HZ = 20.0
@@ -21,9 +21,7 @@ LEASH_CM = 300.0  # max altitude error kept in the target, as the firmware's lea
 TAKEOFF_JUMP_CM = 20.0  # AC_PosControl's takeoff target jump
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class AltHoldOutput:
     """One step's result: throttle 0..1 plus the cascade's intermediate targets."""
 

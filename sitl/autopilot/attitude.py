@@ -3,18 +3,16 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from sitl.autopilot.gains import Gains
 from sitl.autopilot.pid import Pid
+from sitl.tick_record import tick_record
 
 RATE_MAX_RADS = math.radians(180.0)  # ANGLE_RATE_MAX of 3.2.1 (18000 cdeg/s)
 YAW_OUT_MAX = 0.4  # yaw authority kept below roll/pitch, as the motors' yaw headroom
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class AttitudeOutput:
     """Normalised roll, pitch, yaw demands (±1) and the rate targets behind them."""
 

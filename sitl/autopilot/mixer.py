@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from sitl.tick_record import tick_record
 
 # (roll, pitch, yaw) factors from AP_MotorsMatrix: roll = cos(angle+90°), pitch = cos(angle),
 # yaw +1 for the counter-clockwise props (1, 2), -1 for the clockwise ones (3, 4).
@@ -17,9 +17,7 @@ PLUS_FACTORS: tuple[tuple[float, float, float], ...] = (
 PHYSICS_ORDER: tuple[int, int, int, int] = (2, 0, 3, 1)
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class MixerOutput:
     """Motor outputs 0..1 in ArduCopter order (1 right, 2 left, 3 front, 4 back)."""
 

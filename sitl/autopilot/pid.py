@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from sitl.tick_record import tick_record
+
 
 @dataclass(frozen=True)
 class PidGains:
@@ -17,9 +19,7 @@ class PidGains:
     d_filt_hz: float = 20.0
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class PidTerms:
     """One update's contributions, for diagnostics."""
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 from sitl.autopilot.mixer import MixerOutput
 from sitl.autopilot.profile import FlightMode
+from sitl.tick_record import tick_record
 
 
 class SystemStatus(enum.IntEnum):
@@ -18,9 +19,7 @@ class SystemStatus(enum.IntEnum):
     CRITICAL = 5
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class SensorSample:
     """What the autopilot's sensors delivered this tick (SI, body FRD)."""
 

@@ -10,11 +10,11 @@ thrust.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from sitl.sensor_params import BaroParams
+from sitl.tick_record import tick_record
 
 _P0_PA = 101325.0
 _K = 2.25577e-5  # 1/m, ISA troposphere lapse term
@@ -31,9 +31,7 @@ def isa_altitude_m(pressure_pa: float) -> float:
     return (1.0 - (pressure_pa / _P0_PA) ** (1.0 / _EXP)) / _K
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class BaroSample:
     """One barometer reading."""
 

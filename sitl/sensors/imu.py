@@ -11,12 +11,12 @@ so a = counts · g · full_scale_g / 32768; that is what `acc_b` holds.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from sitl.params import GRAVITY_MPS2
 from sitl.sensor_params import ImuParams
+from sitl.tick_record import tick_record
 
 Vec3 = tuple[float, float, float]
 Counts3 = tuple[int, int, int]
@@ -24,9 +24,7 @@ Counts3 = tuple[int, int, int]
 _FULL_SCALE = 32768
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class ImuSample:
     """One IMU reading: SI values are the counts times the LSB (quantised, saturated)."""
 

@@ -3,17 +3,15 @@
 from __future__ import annotations
 
 import collections
-from dataclasses import dataclass
 
 import numpy as np
 
 from sitl.rotation import Quat, Vec3, quat_mul, quat_normalize
 from sitl.sensor_params import MocapParams
+from sitl.tick_record import tick_record
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class MocapSample:
     """A tracked pose: NED position and q_nb (w, x, y, z)."""
 

@@ -14,7 +14,6 @@ from __future__ import annotations
 import enum
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -30,6 +29,7 @@ from sitl.geometry import (
 )
 from sitl.rotation import Quat, Vec3, rotate_b_to_n
 from sitl.sensor_params import ProximityParams
+from sitl.tick_record import tick_record
 
 
 class ProximityFacing(enum.IntEnum):
@@ -53,9 +53,7 @@ FACING_AXIS_B: dict[ProximityFacing, Vec3] = {
 }
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class ProximitySample:
     """One IR reading; distance_m is None when nothing is inside the cone and range."""
 

@@ -12,17 +12,14 @@ firmwares report 0 on the ground. Over carpet (thesis Ch. 7) some echoes come ba
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from sitl.sensor_params import SonarParams
+from sitl.tick_record import tick_record
 from sitl.world import FloorMaterial
 
 
-# Not frozen: one is built every tick, and a frozen dataclass's __init__ (object.__setattr__ per
-# field) costs about three times a plain one's. Nothing changes one once built.
-@dataclass(slots=True)
+@tick_record
 class SonarSample:
     """A sonar reading; distance_m is 0 when not valid."""
 
