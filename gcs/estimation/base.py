@@ -156,6 +156,8 @@ class AltEstimator(ABC):
         # did not take (a carpet's repeats, refused late echoes) is the estimator's to bridge,
         # on its barometer too; so is a stream that stopped whole (a vehicle fallen behind,
         # whose burst the catch-up replays: a command it has not flown yet predicts nothing).
+        # Alive: a sample within half the stale time, as a lossy link still brings one every
+        # few ticks and a stall none for the whole gap.
         lost = (self._sonar_heard_s <= self._last_sonar_t_s
                 and t_s - self._imu_t_s < 0.5 * p.stale_after_s)
         if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or at_rest
