@@ -9,10 +9,14 @@
 2. The bundled SITL over TCP at 2x, stopped (SIGSTOP) for `--stop` of every `--every` wall
    seconds: `quadgcs fly --connect` with a 10 s hold at 1 m and a 1 m step, per profile and
    seed, scored against the SITL's ground truth.
+3. The same stall in lockstep (`sitl.lockstep.Stall`: 0.3 of every 0.6 simulated seconds),
+   where it falls at the same moments for every run of a seed: the spread over many seeds
+   that the wall-clock flights of 2. sample a few points of.
 
 Prints numbers; asserts nothing.
 
     .venv/bin/python bench/bursts.py [--seeds 8] [--flights 3] [--stop 0.15] [--every 0.3]
+                                     [--lockstep-seeds 30]
 """
 
 from __future__ import annotations
@@ -29,7 +33,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from gcs.cli import build_parser  # noqa: E402
-from gcs.commands.fly import fly  # noqa: E402
+from gcs.commands.fly import fly, fly_session  # noqa: E402
+from gcs.flight import FlightPlan  # noqa: E402
+from gcs.lockstep_session import LockstepSession  # noqa: E402
+from gcs.session import SessionOptions  # noqa: E402
 from tests.e2e.sitl_proc import SitlProcess, starved  # noqa: E402
 from tests.gcs.test_estimation_bursts import fly_bursts  # noqa: E402
 
@@ -75,17 +82,45 @@ def flights(n: int, stop_s: float, every_s: float) -> None:
                   f"{'never' if settle is None else f'in {settle:.2f} s'}")
 
 
+def stalled_lockstep(profile: str, seed: int, stop_s: float, every_s: float) -> dict:
+    options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
+                             fix_failsafe=True)
+    with LockstepSession(options, faults={"stall": [stop_s, every_s]}) as session:
+        return fly_session(session, FlightPlan(alt_m=1.0, hold_s=10.0, step_m=1.0,
+                                               step_observe_s=12.0), pilot_signals=False)
+
+
+def lockstep(n: int, stop_s: float, every_s: float) -> None:
+    print(f"3. lockstep, stalled {stop_s} s of every {every_s} s (simulated), 1 m step watched "
+          f"12 s, seeds 1-{n}")
+    for profile in ("apm25", "copter4"):
+        runs = [stalled_lockstep(profile, seed, stop_s, every_s) for seed in range(1, n + 1)]
+        ok = [r for r in runs if r["status"] == "ok"]
+        rms = [100 * r["rms_error_m"] for r in ok]
+        over = [r["step"]["overshoot_pct"] for r in ok]
+        settled = [r["step"]["settle_time_s"] for r in ok]
+        times = [t for t in settled if t is not None]
+        print(f"   {profile:7s} {len(ok)}/{n} ok; hold RMS median {np.median(rms):.1f}, worst "
+              f"{max(rms):.1f} cm; overshoot median {np.median(over):.1f}, range "
+              f"{min(over):.1f}-{max(over):.1f} %; settled {len(times)}/{len(ok)}, in "
+              f"{min(times):.2f}-{max(times):.2f} s (median {np.median(times):.2f}); over 8 s: "
+              f"{sum(t > 8.0 for t in times)}")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=8, help="synthetic flights per pattern")
     ap.add_argument("--flights", type=int, default=3, help="SITL flights per profile")
     ap.add_argument("--stop", type=float, default=0.15, help="wall seconds stopped")
     ap.add_argument("--every", type=float, default=0.3, help="wall seconds between stops")
+    ap.add_argument("--lockstep-seeds", type=int, default=30,
+                    help="lockstep flights per profile (the stall at 2x: twice --stop, --every)")
     a = ap.parse_args()
     if not 0.0 < a.stop < a.every:
         ap.error("need 0 < --stop < --every")
     synthetic(a.seeds)
     flights(a.flights, a.stop, a.every)
+    lockstep(a.lockstep_seeds, 2 * a.stop, 2 * a.every)
     return 0
 
 

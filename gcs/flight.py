@@ -102,6 +102,9 @@ class FlightPlan:
             raise ValueError(f"hold time must be > 0 s, got {self.hold_s}")
         if self.takeoff_delay_s < 0.0:
             raise ValueError(f"take-off delay must be >= 0 s, got {self.takeoff_delay_s}")
+        if self.step_m and self.step_observe_s <= self.step_smooth_s:
+            raise ValueError(f"the step must be watched longer than {self.step_smooth_s} s, got "
+                             f"{self.step_observe_s}")
         if not 0.2 <= self.alt_m + self.step_m <= 3.5:
             raise ValueError(f"step to {self.alt_m + self.step_m} m leaves 0.2..3.5 m")
 

@@ -64,8 +64,9 @@ class LockstepOptions:
     truth: bool = False
     signing_key: bytes | None = None
     # the vehicle links' faults (sitl.lockstep.LinkFaults's fields: loss, fade, fade_start_s,
-    # fade_s; seeded from `seed`; "vehicles": the sysids that suffer them, default every one),
-    # None: a clean link
+    # fade_s; seeded from `seed`; "vehicles": the sysids that suffer them, default every one;
+    # "stall": [stop_s, every_s] or [stop_s, every_s, start_s], the whole SITL stopped as
+    # sitl.lockstep.Stall says), None: a clean link
     faults: dict[str, Any] | None = None
 
 
@@ -92,7 +93,10 @@ class BundledLockstep:
                                      options.seed, options.noise, options.signing_key)
             given = dict(options.faults or {})
             hit = _faulty_sysids(given.pop("vehicles", None), options.vehicles)
-            faults = (None if options.faults is None
+            stall = given.pop("stall", None)
+            if stall is not None:
+                self.sitl.stall = module.Stall(*stall)
+            faults = (None if options.faults is None or not given
                       else module.LinkFaults(**{"seed": options.seed, **given}))
         except (ValueError, OSError, TypeError) as exc:
             where = f"--world {options.world}: " if isinstance(options.world, Path) else ""

@@ -83,6 +83,43 @@ class LinkFaults:
                 and self.fade_start_s <= t_s < self.fade_start_s + self.fade_s)
 
 
+@dataclass(frozen=True, slots=True)
+class Stall:
+    """The whole SITL stopped for `stop_s` of every `every_s` simulated seconds, from
+    `start_s` on, as a loaded machine stops a SITL process (SIGSTOP, SIGCONT): its vehicles,
+    motion capture and truth neither fly nor send, and on waking it runs the ticks it missed at
+    once, so everything they sent arrives in one burst. Its clock is the station's, so the
+    stall falls at the same moments of a flight for every run of a seed."""
+
+    stop_s: float
+    every_s: float
+    start_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.stop_s < self.every_s or self.start_s < 0.0:
+            raise ValueError(f"stall {self.stop_s} s of every {self.every_s} s from "
+                             f"{self.start_s} s: expected 0 < stop < every and start >= 0")
+
+    def resumes_s(self, t_s: float) -> float:
+        """The earliest time at or after `t_s` at which the SITL runs."""
+        if t_s < self.start_s:
+            return t_s
+        stopped_at = self.start_s + self.every_s - self.stop_s
+        k = math.floor((t_s - self.start_s) / self.every_s)
+        begin = stopped_at + k * self.every_s
+        return begin + self.stop_s if begin <= t_s else t_s
+
+    def reached_s(self, t_s: float) -> float:
+        """How far the SITL's own time has run when the clock reads `t_s`: `t_s`, or the
+        moment it was stopped."""
+        if t_s < self.start_s:
+            return t_s
+        stopped_at = self.start_s + self.every_s - self.stop_s
+        k = math.floor((t_s - self.start_s) / self.every_s)
+        begin = stopped_at + k * self.every_s
+        return begin if begin <= t_s < begin + self.stop_s else t_s
+
+
 class _Lossy:
     """One way of a faulty port: whole frames through or lost, as the faults say."""
 
@@ -203,6 +240,7 @@ class LockstepSitl:
         self._mocap = MocapEncoder(mavlink1)
         self._truth = TruthEncoder(mavlink1)
         self.ticks = 0
+        self.stall: Stall | None = None
 
     @property
     def t_s(self) -> float:
@@ -242,9 +280,11 @@ class LockstepSitl:
 
     # ------------------------------------------------------------------ time
     def advance_to(self, t_s: float) -> None:
-        """Run the vehicles' ticks up to `t_s`; the clock reads `t_s` after (never backwards)."""
+        """Run the vehicles' ticks up to `t_s` (a stalled SITL: up to where it stopped); the
+        clock reads `t_s` after (never backwards)."""
         sim = self.sim
-        while sim.t_s + sim.dt_s <= t_s + _EPS_S:
+        until = t_s if self.stall is None else self.stall.reached_s(t_s)
+        while sim.t_s + sim.dt_s <= until + _EPS_S:
             self._tick()
         self._now_s = max(self._now_s, t_s)
 
@@ -252,8 +292,18 @@ class LockstepSitl:
         """Tick until `done()` holds (checked before each tick) or `timeout_s` has passed."""
         end = self._now_s + max(0.0, timeout_s)
         sim = self.sim
+        stall = self.stall
         while not done():
-            if sim.t_s + sim.dt_s > end + _EPS_S:
+            due = sim.t_s + sim.dt_s
+            if stall is not None:
+                # a stopped SITL sends nothing until it wakes, then all it missed at once
+                due = max(self._now_s, stall.resumes_s(due))
+                if due > end + _EPS_S:
+                    self._now_s = max(self._now_s, end)
+                    return
+                self.advance_to(due)
+                continue
+            if due > end + _EPS_S:
                 self._now_s = max(self._now_s, end)
                 return
             self._tick()

@@ -40,6 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--hold", type=float, default=30.0, help="hold time, s (default 30)")
     p.add_argument("--step", type=float, default=0.0,
                    help="after the hold, step the setpoint by this many m and score it")
+    p.add_argument("--step-watch", type=float, default=FlightPlan().step_observe_s, metavar="S",
+                   help="watch the step this long before landing; a step still outside its "
+                        f"band then never settled (default {FlightPlan().step_observe_s:g})")
     p.add_argument("--speedup", type=float, default=1.0,
                    help="run the bundled SITL and the loop this many times faster (default 1); "
                         "with --connect only for a simulator on this machine started with the "
@@ -61,9 +64,9 @@ ABSURD_RMS_M = 0.5
 def _plan(args: argparse.Namespace) -> FlightPlan:
     try:
         return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step,
-                          takeoff_delay_s=args.takeoff_delay)
+                          step_observe_s=args.step_watch, takeoff_delay_s=args.takeoff_delay)
     except ValueError as exc:
-        raise UsageError(f"--alt/--hold/--step: {exc}") from None
+        raise UsageError(f"--alt/--hold/--step/--step-watch: {exc}") from None
 
 
 class LivePrinter:

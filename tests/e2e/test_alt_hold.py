@@ -68,17 +68,20 @@ def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str)
     its own time (gcs/estimation/catch_up.py).
 
     The vehicle itself still flies each stall on the last override, a 0.3 s delay in the
-    loop, so the step's overshoot depends on where the stalls fall in it: with motion capture
-    holding the spot, apm25 seeds 1-6 overshot 0.7-24 % and settled in 1.7-7.3 s
-    (bench/bursts.py, this machine), one fresh-clone CI run of seed 3 overshot 42 %. The
-    bounds keep that spread and still fail the old handling on both counts."""
+    loop, so the step's overshoot and settling depend on where the stalls fall in it: the same
+    stall in lockstep (tests/gcs/test_stalled_sitl.py, seeds 1-30) overshot 16-45 % and settled
+    in 2.4-8.2 s on apm25, and one fresh-clone CI run of seed 3 here overshot 42 %. Watched
+    for the default 8 s, a step settling at 8.2 s reads "never", as this flight did in a CI
+    run and once in six runs here, so it watches 12 s. The bounds keep that spread and
+    still fail the old handling on both counts."""
     sitl = SitlProcess(["--tcp", "0", "--speedup", "2", "--seed", "3", "--profile", profile,
                         "--mocap-port", "0"], ROOT)
     try:
         with starved(sitl.proc, 0.15, 0.3):
             s = fly_json("--connect", "tcp:" + sitl.endpoint(1, "tcp"), "--mocap", sitl.mocap_url(),
                          "--alt", "1.0",
-                         "--hold", "10", "--step", "1.0", "--speedup", "2")
+                         "--hold", "10", "--step", "1.0", "--step-watch", "12",
+                         "--speedup", "2")
     finally:
         sitl.stop()
     assert s["status"] == "ok", s["reason"]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
-from sitl.lockstep import PORT_BACKLOG_BYTES, LinkFaults, MemoryPort, PortClosed, start
+from sitl.lockstep import PORT_BACKLOG_BYTES, LinkFaults, MemoryPort, PortClosed, Stall, start
 
 
 def _open(port: MemoryPort) -> MemoryPort:
@@ -187,3 +187,37 @@ def test_a_port_nobody_opened_gets_nothing_as_a_tcp_endpoint_without_a_client() 
     n_late = len(_decode(late.read(PORT_BACKLOG_BYTES)))
     # 100 Hz poses: the late client has only the half second since it came
     assert n_early > 190 and 45 <= n_late <= 51
+
+
+def test_a_stalled_sitl_sends_nothing_then_what_it_missed_at_once() -> None:
+    sitl = start(seed=1)
+    sitl.stall = Stall(stop_s=0.3, every_s=0.6, start_s=1.0)  # stopped over [1.3, 1.6) and on
+    port, truth = _open(sitl.vehicle_port(1)), _open(sitl.truth_port())
+    sitl.advance_to(1.3)
+    port.read(PORT_BACKLOG_BYTES), truth.read(PORT_BACKLOG_BYTES)
+    ticks = sitl.ticks
+    sitl.advance_to(1.55)
+    # the clock runs on; the SITL neither flies nor sends
+    assert sitl.t_s == pytest.approx(1.55) and sitl.ticks == ticks
+    assert not port.readable and not truth.readable
+    # a wait in the stall ends when the SITL wakes, with the 30 ticks it missed run at once
+    truth.wait_readable(1.0)
+    assert sitl.t_s == pytest.approx(1.6) and sitl.ticks == ticks + 30
+    # the truth reports (50 Hz) of the whole stall, stamped with their own times
+    reports = [m for m in _decode(truth.read(PORT_BACKLOG_BYTES))
+               if m.get_type() == "LOCAL_POSITION_NED"]
+    assert len(reports) == 15
+    assert reports[-1].time_boot_ms - reports[0].time_boot_ms == pytest.approx(280, abs=10)
+    # the next heartbeat (1 Hz, due at 2.0 s) falls in the next stall and comes when it ends
+    port.wait_readable(1.0)
+    assert sitl.t_s == pytest.approx(2.2) and _heartbeats(port) == 1
+
+
+def test_a_stall_is_checked_and_stops_nothing_before_it_starts() -> None:
+    with pytest.raises(ValueError, match="0 < stop < every"):
+        Stall(stop_s=0.6, every_s=0.6)
+    stall = Stall(stop_s=0.3, every_s=0.6, start_s=1.0)
+    assert stall.reached_s(0.5) == 0.5 and stall.resumes_s(0.5) == 0.5
+    assert stall.reached_s(1.45) == pytest.approx(1.3)
+    assert stall.resumes_s(1.45) == pytest.approx(1.6)
+    assert stall.reached_s(1.7) == 1.7 and stall.resumes_s(2.0) == pytest.approx(2.2)
