@@ -33,12 +33,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from gcs.cli import build_parser  # noqa: E402
-from gcs.commands.fly import fly, fly_session  # noqa: E402
-from gcs.flight import FlightPlan  # noqa: E402
-from gcs.lockstep_session import LockstepSession  # noqa: E402
-from gcs.session import SessionOptions  # noqa: E402
+from gcs.commands.fly import fly  # noqa: E402
 from tests.e2e.sitl_proc import SitlProcess, starved  # noqa: E402
 from tests.gcs.test_estimation_bursts import fly_bursts  # noqa: E402
+from tests.gcs.test_stalled_sitl import fly_stalled  # noqa: E402
 
 
 def synthetic(seeds: int) -> None:
@@ -82,19 +80,11 @@ def flights(n: int, stop_s: float, every_s: float) -> None:
                   f"{'never' if settle is None else f'in {settle:.2f} s'}")
 
 
-def stalled_lockstep(profile: str, seed: int, stop_s: float, every_s: float) -> dict:
-    options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
-                             fix_failsafe=True)
-    with LockstepSession(options, faults={"stall": [stop_s, every_s]}) as session:
-        return fly_session(session, FlightPlan(alt_m=1.0, hold_s=10.0, step_m=1.0,
-                                               step_observe_s=12.0), pilot_signals=False)
-
-
 def lockstep(n: int, stop_s: float, every_s: float) -> None:
     print(f"3. lockstep, stalled {stop_s} s of every {every_s} s (simulated), 1 m step watched "
           f"12 s, seeds 1-{n}")
     for profile in ("apm25", "copter4"):
-        runs = [stalled_lockstep(profile, seed, stop_s, every_s) for seed in range(1, n + 1)]
+        runs = [fly_stalled(profile, seed, stop_s, every_s) for seed in range(1, n + 1)]
         ok = [r for r in runs if r["status"] == "ok"]
         rms = [100 * r["rms_error_m"] for r in ok]
         over = [r["step"]["overshoot_pct"] for r in ok]

@@ -18,13 +18,13 @@ from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
 from gcs.session import SessionOptions
 
-STALL = {"stall": [0.3, 0.6]}
 
-
-def fly_stalled(profile: str, seed: int) -> dict[str, Any]:
+def fly_stalled(profile: str, seed: int, stop_s: float = 0.3,
+                every_s: float = 0.6) -> dict[str, Any]:
+    """A 10 s hold at 1 m and a 1 m step watched 12 s, the SITL stalled as given."""
     options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
                              fix_failsafe=True)
-    with LockstepSession(options, faults=STALL) as session:
+    with LockstepSession(options, faults={"stall": [stop_s, every_s]}) as session:
         return fly_session(session, FlightPlan(alt_m=1.0, hold_s=10.0, step_m=1.0,
                                                step_observe_s=12.0), pilot_signals=False)
 
