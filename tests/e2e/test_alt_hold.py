@@ -67,21 +67,22 @@ def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str)
     settled, copter4 held with 22 cm RMS (56 cm at worst). Each sample is now integrated at
     its own time (gcs/estimation/catch_up.py).
 
-    The vehicle itself still flies each stall on the last override, a 0.3 s delay in the
+    The vehicle itself still flies each stall on the last override, a 0.3 s hole in the
     loop, so the step's overshoot and settling depend on where the stalls fall in it: the same
     stall in lockstep (tests/gcs/test_stalled_sitl.py, seeds 1-30) overshot 16-45 % and settled
-    in 2.4-8.2 s on apm25, and one fresh-clone CI run of seed 3 here overshot 42 %. Watched
-    for the default 8 s, a step settling at 8.2 s reads "never", as this flight did in a CI
-    run and once in six runs here, so it watches 12 s. The bounds keep that spread and
-    still fail the old handling on both counts."""
+    in 2.4-8.2 s on apm25. Here the machine places the stalls, and the spread is wider still:
+    in fresh-clone CI runs seed 3 overshot 42 % (apm25), did not settle within 8 s (apm25),
+    and settled only at 10.1 s (copter4).
+    So this flight checks what holds whatever the placement, and the old handling failed
+    (the hold's RMS, the overshoot); the settling is checked on the lockstep stall, where a
+    seed places it the same way every run."""
     sitl = SitlProcess(["--tcp", "0", "--speedup", "2", "--seed", "3", "--profile", profile,
                         "--mocap-port", "0"], ROOT)
     try:
         with starved(sitl.proc, 0.15, 0.3):
             s = fly_json("--connect", "tcp:" + sitl.endpoint(1, "tcp"), "--mocap", sitl.mocap_url(),
                          "--alt", "1.0",
-                         "--hold", "10", "--step", "1.0", "--step-watch", "12",
-                         "--speedup", "2")
+                         "--hold", "10", "--step", "1.0", "--speedup", "2")
     finally:
         sitl.stop()
     assert s["status"] == "ok", s["reason"]
@@ -89,7 +90,6 @@ def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str)
     assert s["rms_error_m"] <= 0.06
     step = s["step"]
     assert step["overshoot_pct"] <= 60.0
-    assert step["settle_time_s"] is not None and step["settle_time_s"] <= 10.0
 
 
 # Beside wall-clock flights only: in one fresh-clone run, beside a CPU-bound test, this
