@@ -100,24 +100,24 @@ class Stall:
             raise ValueError(f"stall {self.stop_s} s of every {self.every_s} s from "
                              f"{self.start_s} s: expected 0 < stop < every and start >= 0")
 
+    def _stopped_at(self, t_s: float) -> float | None:
+        """When the stop that `t_s` falls in began; None if the SITL runs at `t_s`."""
+        if t_s < self.start_s:
+            return None
+        k = math.floor((t_s - self.start_s) / self.every_s)
+        begin = self.start_s + (k + 1) * self.every_s - self.stop_s
+        return begin if begin <= t_s else None
+
     def resumes_s(self, t_s: float) -> float:
         """The earliest time at or after `t_s` at which the SITL runs."""
-        if t_s < self.start_s:
-            return t_s
-        stopped_at = self.start_s + self.every_s - self.stop_s
-        k = math.floor((t_s - self.start_s) / self.every_s)
-        begin = stopped_at + k * self.every_s
-        return begin + self.stop_s if begin <= t_s else t_s
+        begin = self._stopped_at(t_s)
+        return t_s if begin is None else begin + self.stop_s
 
     def reached_s(self, t_s: float) -> float:
         """How far the SITL's own time has run when the clock reads `t_s`: `t_s`, or the
         moment it was stopped."""
-        if t_s < self.start_s:
-            return t_s
-        stopped_at = self.start_s + self.every_s - self.stop_s
-        k = math.floor((t_s - self.start_s) / self.every_s)
-        begin = stopped_at + k * self.every_s
-        return begin if begin <= t_s < begin + self.stop_s else t_s
+        begin = self._stopped_at(t_s)
+        return t_s if begin is None else begin
 
 
 class _Lossy:
@@ -298,16 +298,10 @@ class LockstepSitl:
             if stall is not None:
                 # a stopped SITL sends nothing until it wakes, then all it missed at once
                 due = max(self._now_s, stall.resumes_s(due))
-                if due > end + _EPS_S:
-                    self._now_s = max(self._now_s, end)
-                    return
-                self.advance_to(due)
-                continue
             if due > end + _EPS_S:
                 self._now_s = max(self._now_s, end)
                 return
-            self._tick()
-            self._now_s = max(self._now_s, sim.t_s)
+            self.advance_to(due)
 
     def _tick(self) -> None:
         sim = self.sim
