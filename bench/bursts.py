@@ -7,11 +7,12 @@
    each sample integrated at its own time (the station) and with each tick's samples averaged
    into one (how the station took them before).
 2. The bundled SITL over TCP at 2x, stopped (SIGSTOP) for `--stop` of every `--every` wall
-   seconds: `quadgcs fly --connect` with a 10 s hold at 1 m and a 1 m step, per profile and
-   seed, scored against the SITL's ground truth.
-3. The same stall in lockstep (`sitl.lockstep.Stall`: 0.3 of every 0.6 simulated seconds),
-   where it falls at the same moments for every run of a seed: the spread over many seeds
-   that the wall-clock flights of 2. sample a few points of.
+   seconds: `quadgcs fly --connect` with a 10 s hold at 1 m and a 1 m step (watched 12 s,
+   settled within ±10 cm), per profile and seed, scored against the SITL's ground truth.
+3. The same stall in lockstep (`sitl.lockstep.Stall`: twice `--stop` of every twice
+   `--every` simulated seconds), where it falls at the same moments for every run of a seed:
+   the spread over many seeds that the wall-clock flights of 2. sample a few points of, the
+   settling within ±10 cm and within the usual ±5 cm.
 
 Prints numbers; asserts nothing.
 
@@ -58,7 +59,7 @@ def starved_flight(profile: str, seed: int, stop_s: float, every_s: float) -> di
         args = build_parser().parse_args([
             "fly", "--no-record", "--fix-failsafe", "--connect", "tcp:" + sitl.endpoint(1, "tcp"),
             "--mocap", sitl.mocap_url(), "--alt", "1.0", "--hold", "10", "--step", "1.0",
-            "--speedup", "2"])
+            "--step-watch", "12", "--step-band", "0.1", "--speedup", "2"])
         with starved(sitl.proc, stop_s, every_s), contextlib.redirect_stdout(io.StringIO()):
             return fly(args)
     finally:
@@ -76,7 +77,7 @@ def flights(n: int, stop_s: float, every_s: float) -> None:
                   f"{(s.get('rms_error_m') or float('nan')) * 100:.1f} cm, max "
                   f"{(s.get('max_error_m') or float('nan')) * 100:.1f} cm "
                   f"({s.get('error_source')}); step overshoot "
-                  f"{step.get('overshoot_pct', float('nan')):.1f} %, settled "
+                  f"{step.get('overshoot_pct', float('nan')):.1f} %, settled within +-10 cm "
                   f"{'never' if settle is None else f'in {settle:.2f} s'}")
 
 
@@ -84,17 +85,19 @@ def lockstep(n: int, stop_s: float, every_s: float) -> None:
     print(f"3. lockstep, stalled {stop_s} s of every {every_s} s (simulated), 1 m step watched "
           f"12 s, seeds 1-{n}")
     for profile in ("apm25", "copter4"):
-        runs = [fly_stalled(profile, seed, stop_s, every_s) for seed in range(1, n + 1)]
-        ok = [r for r in runs if r["status"] == "ok"]
-        rms = [100 * r["rms_error_m"] for r in ok]
-        over = [r["step"]["overshoot_pct"] for r in ok]
-        settled = [r["step"]["settle_time_s"] for r in ok]
-        times = [t for t in settled if t is not None]
-        print(f"   {profile:7s} {len(ok)}/{n} ok; hold RMS median {np.median(rms):.1f}, worst "
-              f"{max(rms):.1f} cm; overshoot median {np.median(over):.1f}, range "
-              f"{min(over):.1f}-{max(over):.1f} %; settled {len(times)}/{len(ok)}, in "
-              f"{min(times):.2f}-{max(times):.2f} s (median {np.median(times):.2f}); over 8 s: "
-              f"{sum(t > 8.0 for t in times)}")
+        for band_m in (0.1, 0.05):
+            runs = [fly_stalled(profile, seed, stop_s, every_s, band_m)
+                    for seed in range(1, n + 1)]
+            ok = [r for r in runs if r["status"] == "ok"]
+            rms = [100 * r["rms_error_m"] for r in ok]
+            over = [r["step"]["overshoot_pct"] for r in ok]
+            times = [t for r in ok if (t := r["step"]["settle_time_s"]) is not None]
+            settled = (f"in {min(times):.2f}-{max(times):.2f} s (median {np.median(times):.2f})"
+                       if times else "")
+            print(f"   {profile:7s} {len(ok)}/{n} ok; hold RMS median {np.median(rms):.1f}, "
+                  f"worst {max(rms):.1f} cm; overshoot median {np.median(over):.1f}, range "
+                  f"{min(over):.1f}-{max(over):.1f} %; within +-{100 * band_m:.0f} cm settled "
+                  f"{len(times)}/{len(ok)} {settled}")
 
 
 def main() -> int:
@@ -110,7 +113,8 @@ def main() -> int:
         ap.error("need 0 < --stop < --every")
     synthetic(a.seeds)
     flights(a.flights, a.stop, a.every)
-    lockstep(a.lockstep_seeds, 2 * a.stop, 2 * a.every)
+    if a.lockstep_seeds:
+        lockstep(a.lockstep_seeds, 2 * a.stop, 2 * a.every)
     return 0
 
 

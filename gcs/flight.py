@@ -105,6 +105,8 @@ class FlightPlan:
         if self.step_m and self.step_observe_s <= self.step_smooth_s:
             raise ValueError(f"the step must be watched longer than {self.step_smooth_s} s, got "
                              f"{self.step_observe_s}")
+        if self.step_m and not self.step_band_m > 0.0:
+            raise ValueError(f"the step's band must be > 0 m, got {self.step_band_m}")
         if not 0.2 <= self.alt_m + self.step_m <= 3.5:
             raise ValueError(f"step to {self.alt_m + self.step_m} m leaves 0.2..3.5 m")
 

@@ -43,6 +43,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--step-watch", type=float, default=FlightPlan().step_observe_s, metavar="S",
                    help="watch the step this long before landing; a step still outside its "
                         f"band then never settled (default {FlightPlan().step_observe_s:g})")
+    p.add_argument("--step-band", type=float, default=FlightPlan().step_band_m, metavar="M",
+                   help="the step has settled once its altitude stays within this many m of "
+                        f"the new setpoint (default {FlightPlan().step_band_m:g})")
     p.add_argument("--speedup", type=float, default=1.0,
                    help="run the bundled SITL and the loop this many times faster (default 1); "
                         "with --connect only for a simulator on this machine started with the "
@@ -64,9 +67,10 @@ ABSURD_RMS_M = 0.5
 def _plan(args: argparse.Namespace) -> FlightPlan:
     try:
         return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step,
-                          step_observe_s=args.step_watch, takeoff_delay_s=args.takeoff_delay)
+                          step_observe_s=args.step_watch, step_band_m=args.step_band,
+                          takeoff_delay_s=args.takeoff_delay)
     except ValueError as exc:
-        raise UsageError(f"--alt/--hold/--step/--step-watch: {exc}") from None
+        raise UsageError(f"--alt/--hold/--step/--step-watch/--step-band: {exc}") from None
 
 
 class LivePrinter:

@@ -68,21 +68,20 @@ def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str)
     its own time (gcs/estimation/catch_up.py).
 
     The vehicle itself still flies each stall on the last override, a 0.3 s hole in the
-    loop, so the step's overshoot and settling depend on where the stalls fall in it: the same
-    stall in lockstep (tests/gcs/test_stalled_sitl.py, seeds 1-30) overshot 16-45 % and settled
-    in 2.4-8.2 s on apm25. Here the machine places the stalls, and the spread is wider still:
-    in fresh-clone CI runs seed 3 overshot 42 % (apm25), did not settle within 8 s (apm25),
-    and settled only at 10.1 s (copter4).
-    So this flight checks what holds whatever the placement, and the old handling failed
-    (the hold's RMS, the overshoot); the settling is checked on the lockstep stall, where a
-    seed places it the same way every run."""
+    loop, and the hold wobbles with it (about 2 cm RMS). Within the ±5 cm band of the other
+    steps, when the step counts as settled is decided by that wobble: in fresh-clone CI runs
+    apm25's did not settle within 8 s, and copter4's settled at 10.1 s. Within ±10 cm it is the
+    step's own response: the same stall in lockstep (tests/gcs/test_stalled_sitl.py, seeds
+    1-30) settled in 2.2-2.7 s (apm25) and 2.4-4.0 s (copter4), overshooting 14-27 %; here the
+    machine places the stalls and the spread is wider (one fresh-clone run overshot 42 %)."""
     sitl = SitlProcess(["--tcp", "0", "--speedup", "2", "--seed", "3", "--profile", profile,
                         "--mocap-port", "0"], ROOT)
     try:
         with starved(sitl.proc, 0.15, 0.3):
             s = fly_json("--connect", "tcp:" + sitl.endpoint(1, "tcp"), "--mocap", sitl.mocap_url(),
                          "--alt", "1.0",
-                         "--hold", "10", "--step", "1.0", "--speedup", "2")
+                         "--hold", "10", "--step", "1.0", "--step-watch", "12",
+                         "--step-band", "0.1", "--speedup", "2")
     finally:
         sitl.stop()
     assert s["status"] == "ok", s["reason"]
@@ -90,6 +89,7 @@ def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str)
     assert s["rms_error_m"] <= 0.06
     step = s["step"]
     assert step["overshoot_pct"] <= 60.0
+    assert step["settle_time_s"] is not None and step["settle_time_s"] <= 10.0
 
 
 # Beside wall-clock flights only: in one fresh-clone run, beside a CPU-bound test, this
