@@ -1,0 +1,96 @@
+"""What a radio fade would cost at each moment of a steady hold: the blind touchdown per tick.
+
+Flies `quadgcs fly` (a 60 s hold at 1 m) in lockstep on the bundled SITL, recorded, per seed and
+profile. For every tick of the hold from 10 s on it takes the command the station sent (the
+altitude controller's acceleration, below hover when negative), the estimate's height above the
+rest height and vertical speed, and asks `gcs.supervisor.envelope.blind_touchdown` how fast the
+vehicle would meet the floor if the uplink died right then and the firmware flew that command
+blind until its failsafe (the dialect's `blind_s`) and then braked. That is the risk the blind
+envelope bounds (0.8 m/s for a steady hold) and opens for a climb the hold must stop, which a
+steady hold's own wobble can look like.
+
+Prints per profile: ticks, the share whose blind touchdown would exceed 0.9 and 1.0 m/s, the
+worst, and the most downward command. Heights and speeds are the station's estimate (what the
+bound itself uses), not truth; the rest height is the lowest estimate of the flight, a few mm
+off the supervisor's own, which moves a touchdown at the 0.8 m/s bound by about 0.01 m/s.
+
+    .venv/bin/python bench/blind_risk.py [--seeds 1-8] [--profiles apm25,copter4]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from open_loop import seed_range  # this directory, as the script runs
+
+from firmware_link.records import Dialect
+from gcs.commands.fly import fly_session
+from gcs.flight import FlightPlan
+from gcs.lockstep_session import LockstepSession
+from gcs.session import SessionOptions
+from gcs.supervisor.envelope import blind_touchdown
+from gcs.supervisor.params import SupervisorParams
+from logs import open_recording
+
+SETPOINT_M = 1.0
+HOLD_S = 60.0
+SKIP_S = 10.0  # of the hold: the take-off's end is not a steady hold
+PID_MAX_MPS2 = 6.0
+
+
+def hold_ticks(profile: str, seed: int, tmp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(height above rest m, vertical speed m/s, commanded acceleration m/s²) per hold tick."""
+    out = tmp / f"{profile}-{seed}.mcap"
+    options = SessionOptions(command="fly", profile=profile, seed=seed, record=True,
+                             output=out, fix_failsafe=True)
+    with LockstepSession(options) as session:
+        fly_session(session, FlightPlan(alt_m=SETPOINT_M, hold_s=HOLD_S), pilot_signals=False)
+    estimates: dict[int, dict] = {}
+    control: list[tuple[int, dict]] = []
+    for topic, log_ns, data in open_recording(out).raw_messages():
+        if topic == "/gcs/estimate":
+            estimates[log_ns] = json.loads(data)
+        elif topic == "/gcs/alt_controller":
+            control.append((log_ns, json.loads(data)))
+    rest = min(e["alt_m"] for e in estimates.values())
+    steady = [(estimates[ns], c) for ns, c in control
+              if ns in estimates and abs(c["setpoint_m"] - SETPOINT_M) < 1e-6]
+    steady = steady[int(SKIP_S / 0.025):]
+    h = np.array([e["alt_m"] - rest for e, _ in steady])
+    w = np.array([e["vel_mps"] for e, _ in steady])
+    a = np.array([c["accel_cmd_mps2"] for _, c in steady])
+    return h, w, a
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", default="1-8", help="SITL seeds, FIRST-LAST (default 1-8)")
+    ap.add_argument("--profiles", default="apm25,copter4", help="comma-separated profiles")
+    args = ap.parse_args()
+    seeds = seed_range(args.seeds)
+    print(f"lockstep, {HOLD_S:g} s hold at {SETPOINT_M} m from {SKIP_S:g} s in, seeds "
+          f"{seeds[0]}-{seeds[-1]}: the touchdown if the uplink died at each tick (estimate)")
+    print(f"{'profile':8} {'ticks':>7} {'> 0.9 m/s':>10} {'> 1.0 m/s':>10} {'worst m/s':>10} "
+          f"{'most down m/s2':>15}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for profile in args.profiles.split(","):
+            blind = SupervisorParams.for_dialect(Dialect(profile)).blind(PID_MAX_MPS2)
+            parts = [hold_ticks(profile, s, Path(tmp)) for s in seeds]
+            h, w, a = (np.concatenate(x) for x in zip(*parts, strict=True))
+            down = np.array([blind_touchdown(hi, wi, max(-ai, 0.0), blind)
+                             for hi, wi, ai in zip(h, w, a, strict=True)])
+            print(f"{profile:8} {down.size:7d} {100 * np.mean(down > 0.9):9.2f}% "
+                  f"{100 * np.mean(down > 1.0):9.2f}% {down.max():10.2f} {a.min():15.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
