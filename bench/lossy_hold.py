@@ -23,8 +23,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from open_loop import seed_range  # this directory, as the script runs
-
+from bench.open_loop import seed_range
 from gcs.commands.fly import fly_session
 from gcs.errors import FlightFailed
 from gcs.flight import FlightPlan

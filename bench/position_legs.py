@@ -19,8 +19,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from open_loop import seed_range  # this directory, as the script runs
-
+from bench.open_loop import seed_range
 from gcs.position_legs import fly_legs
 
 
