@@ -31,6 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from bench.open_loop import seed_range
 from firmware_link.records import Dialect
+from gcs.altitude_controller import AltitudeControllerParams
 from gcs.commands.fly import fly_session
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
@@ -42,7 +43,6 @@ from logs import open_recording
 SETPOINT_M = 1.0
 HOLD_S = 60.0
 SKIP_S = 10.0  # of the hold: the take-off's end is not a steady hold
-PID_MAX_MPS2 = 6.0
 
 
 def hold_ticks(profile: str, seed: int, tmp: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -81,7 +81,9 @@ def main() -> int:
           f"{'most down m/s2':>15}")
     with tempfile.TemporaryDirectory() as tmp:
         for profile in args.profiles.split(","):
-            blind = SupervisorParams.for_dialect(Dialect(profile)).blind(PID_MAX_MPS2)
+            # the envelope the station's own supervisor flies with (the hold's default gains)
+            blind = SupervisorParams.for_dialect(Dialect(profile)).blind(
+                AltitudeControllerParams().gains.out_max)
             parts = [hold_ticks(profile, s, Path(tmp)) for s in seeds]
             h, w, a = (np.concatenate(x) for x in zip(*parts, strict=True))
             down = np.array([blind_touchdown(hi, wi, max(-ai, 0.0), blind)

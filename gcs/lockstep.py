@@ -96,8 +96,7 @@ class BundledLockstep:
             stall = given.pop("stall", None)
             if stall is not None:
                 self.sitl.stall = module.Stall(*stall)
-            faults = (None if options.faults is None or not given
-                      else module.LinkFaults(**{"seed": options.seed, **given}))
+            faults = module.LinkFaults(**{"seed": options.seed, **given}) if given else None
         except (ValueError, OSError, TypeError) as exc:
             where = f"--world {options.world}: " if isinstance(options.world, Path) else ""
             raise UsageError(f"{where}{exc}") from None

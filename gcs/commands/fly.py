@@ -40,12 +40,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--hold", type=float, default=30.0, help="hold time, s (default 30)")
     p.add_argument("--step", type=float, default=0.0,
                    help="after the hold, step the setpoint by this many m and score it")
-    p.add_argument("--step-watch", type=float, default=FlightPlan().step_observe_s, metavar="S",
+    plan = FlightPlan()
+    p.add_argument("--step-watch", type=float, default=plan.step_observe_s, metavar="S",
                    help="watch the step this long before landing; a step still outside its "
-                        f"band then never settled (default {FlightPlan().step_observe_s:g})")
-    p.add_argument("--step-band", type=float, default=FlightPlan().step_band_m, metavar="M",
+                        f"band then never settled (default {plan.step_observe_s:g})")
+    p.add_argument("--step-band", type=float, default=plan.step_band_m, metavar="M",
                    help="the step has settled once its altitude stays within this many m of "
-                        f"the new setpoint (default {FlightPlan().step_band_m:g})")
+                        f"the new setpoint (default {plan.step_band_m:g})")
     p.add_argument("--speedup", type=float, default=1.0,
                    help="run the bundled SITL and the loop this many times faster (default 1); "
                         "with --connect only for a simulator on this machine started with the "

@@ -122,8 +122,10 @@ OPEN_LOOP_4X = ("with the uplink dead ArduCopter 4.x flies the last override for
 # problem lines) and why; everything else the case promises (the landing, the disarm, the
 # touchdown speed, the exit code, LAND asked) stays strict. The open-loop seconds may climb past
 # the setpoint; the blind-flight envelope keeps them off the floor (60 lockstep seeds: touchdown
-# 0.87 m/s at worst). The lossy case is strict: bench/lossy_hold.py, 60 lockstep seeds, worst
-# 8.2 cm on apm25 and 8.1 cm on copter4.
+# 0.87 m/s at worst), except where it opened on the hold's own wobble (bench/blind_risk.py:
+# 0.1-0.3 % of a steady hold's ticks; one fresh-clone run touched down at 1.27 m/s), which stays
+# strict here: the issue's 1.0 m/s is not a drift to report. The lossy case is strict:
+# bench/lossy_hold.py, 60 lockstep seeds, worst 8.2 cm on apm25 and 8.1 cm on copter4.
 REPORTED = {
     "uplink-apm25-tcp": ((ROSE,), OPEN_LOOP),
     "both-apm25-tcp": ((ROSE,), OPEN_LOOP),
