@@ -194,11 +194,11 @@ class Pid:
         integrator holds its value (the caller knows the actuator beyond the PID is clamped, or
         the plant cannot respond, e.g. a vehicle standing on the floor). `slew_per_s` lowers the
         setpoint profile's speed for this move (a slow climb), braking as the profile does.
-        `out_min` raises the output's lower limit for this step (never lowers it)."""
+        `out_min` raises the output's lower limit for this step (never lowers it), below which
+        only the profile's own deceleration (its feed-forward) may still go."""
         if dt_s <= 0.0:
             raise ValueError(f"dt_s must be > 0, got {dt_s}")
         g = self.gains
-        lo = g.out_min if out_min is None else min(max(out_min, g.out_min), g.out_max)
         if self._shaped is None:
             self._shaped = target
         prev_rate = self._shaped_rate
@@ -210,6 +210,9 @@ class Pid:
         accel = min(max((shaped_rate - prev_rate) / dt_s, -g.setpoint_accel_per_s2),
                     g.setpoint_accel_per_s2)
         ff = g.ff_accel * accel
+        # a raised floor bounds the loop's correction, not the profile's own planned braking
+        lo = (g.out_min if out_min is None
+              else min(max(out_min + min(ff, 0.0), g.out_min), g.out_max))
         error = reference - measurement
 
         if measurement_rate is not None:

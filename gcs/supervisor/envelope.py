@@ -13,9 +13,15 @@ reaches ±0.6 m/s²): that clipped noise is the price.
 
 Only a steady hold is bounded so. A vehicle the hold must stop (climbing past a carpet's late
 echoes, say) needs braking that, held blind, would put it into the floor: bounding it there
-throws the vehicle at the ceiling instead, which the station cannot see. So between
-`steady_mps` and twice that of vertical speed the bound opens to the PID's own limit, and a fade
-in those moments is as unbounded as it ever was; climbs are never bounded.
+throws the vehicle at the ceiling instead, which the station cannot see. So a climb gets the
+braking that stops it `band_m` above the setpoint, `brake_factor` times over (the vehicle answers
+late), and a fade in those moments is as unbounded as it ever was; climbs are never bounded.
+The climb is the estimate's, whose velocity in a steady hold wanders to 0.15–0.2 m/s while the
+vehicle's stays under 0.05: braked by speed alone, that noise opened the bound to the PID's.
+Measured against the setpoint it asks a few tenths of a m/s², under the steady bound or near it.
+A profile's own planned braking (a take-off's end) passes below the bound (gcs/pid.py). A sink
+past `steady_mps` opens the bound as before, by twice it to the PID's limit: bounding those
+moments put a lossy-link hold 0.106 m off its setpoint (1 of 60 seeds, apm25).
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+_MIN_ROOM_M = 0.01  # at the band or past it, a climb is braked as if 1 cm short of it
 _SEARCH_STEPS = 12  # bisection over [0, max_mps2]: 6 m/s² / 4096 ≈ 1.5 mm/s², ample
 
 
@@ -33,8 +40,10 @@ class BlindFlight:
     blind_s: float  # the last command flown this long before the firmware acts
     brake_mps2: float  # then the firmware's LAND brakes a descent at least this hard
     touchdown_mps: float  # the fastest it may meet the floor
-    steady_mps: float  # the bound holds up to this vertical speed, and opens by twice it
     max_mps2: float  # the most the hold ever asks (the PID's own limit)
+    steady_mps: float  # a sink faster than this opens the bound, by twice it to the PID's
+    band_m: float  # a climb is stopped within this above the setpoint
+    brake_factor: float  # that many times the braking that just stops it there
 
 
 def blind_touchdown(height_m: float, climb_mps: float, sink_mps2: float,
@@ -59,16 +68,24 @@ def blind_touchdown(height_m: float, climb_mps: float, sink_mps2: float,
     return math.sqrt(max(w_t * w_t - 2.0 * blind.brake_mps2 * z_t, 0.0))
 
 
-def blind_sink_limit(height_m: float, climb_mps: float, blind: BlindFlight) -> float:
+def blind_sink_limit(height_m: float, climb_mps: float, above_m: float,
+                     blind: BlindFlight) -> float:
     """The most downward acceleration (m/s², ≥ 0, below hover) a command may ask so that flown
-    blind it meets the floor no faster than `blind.touchdown_mps`; inf when even the PID's
-    limit does. Never below 0: a sink already that fast is the hold's to brake, and an envelope
-    that demanded a climb would turn a wrong estimate (a carpet's late echo) into one."""
+    blind it meets the floor no faster than `blind.touchdown_mps`, or the braking that stops a
+    climb of `climb_mps` from `above_m` over the setpoint in time; inf when even the PID's limit
+    does. Never below 0: a sink already that fast is the hold's to brake, and an envelope that
+    demanded a climb would turn a wrong estimate (a carpet's late echo) into one."""
     if not math.isfinite(blind.touchdown_mps):
         return math.inf
     limit = _blind_limit(height_m, climb_mps, blind)
-    opening = (abs(climb_mps) - blind.steady_mps) / blind.steady_mps
-    if opening <= 0.0 or not math.isfinite(limit):
+    if not math.isfinite(limit):
+        return limit
+    if climb_mps > 0.0:
+        room = max(blind.band_m - above_m, _MIN_ROOM_M)
+        need = blind.brake_factor * climb_mps * climb_mps / (2.0 * room)
+        return math.inf if need >= blind.max_mps2 else max(limit, need)
+    opening = (-climb_mps - blind.steady_mps) / blind.steady_mps
+    if opening <= 0.0:
         return limit
     return math.inf if opening >= 1.0 else limit + opening * (blind.max_mps2 - limit)
 

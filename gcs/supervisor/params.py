@@ -77,15 +77,24 @@ class SupervisorParams:
     blind_s: float = 2.5
     blind_brake_mps2: float = 1.0
     blind_touchdown_mps: float = 0.8
-    # the bound holds up to this vertical speed (the hold's own wander is a few cm/s) and opens
-    # by twice it; at 0.25 m/s a lossy link's false climbs rose 11 cm before braking began
+    # A climb gets this many times the braking that stops it this far over the setpoint. 60
+    # seeds a profile: lossy-link holds stay within ±0.1 m and take-offs within 5 %; at twice
+    # over, the steady hold's noisier climbs still asked for touchdowns above 1.0 m/s
+    blind_band_m: float = 0.1
+    blind_brake_factor: float = 1.5
+    # a sink faster than this opens the bound, by twice it to the PID's own limit
     blind_steady_mps: float = 0.15
 
     def __post_init__(self) -> None:
         if not 0.0 < self.degraded_after_s < self.lost_after_s:
             raise ValueError("need 0 < degraded_after_s < lost_after_s")
-        if min(self.blind_s, self.blind_steady_mps, self.blind_touchdown_mps) <= 0.0:
-            raise ValueError("blind_s, blind_steady_mps and blind_touchdown_mps must be > 0")
+        if min(self.blind_s, self.blind_band_m, self.blind_steady_mps,
+               self.blind_touchdown_mps) <= 0.0:
+            raise ValueError("blind_s, blind_band_m, blind_steady_mps and blind_touchdown_mps "
+                             "must be > 0")
+        if self.blind_brake_factor < 1.0:
+            raise ValueError("blind_brake_factor must be >= 1 (it brakes a climb at least as "
+                             f"hard as stopping it needs), got {self.blind_brake_factor}")
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
             if isinstance(v, float) and v < 0.0:
@@ -102,7 +111,8 @@ class SupervisorParams:
     def blind(self, max_mps2: float) -> BlindFlight:
         """The blind-flight envelope, for a hold that asks at most `max_mps2`."""
         return BlindFlight(self.blind_s, self.blind_brake_mps2, self.blind_touchdown_mps,
-                           self.blind_steady_mps, max_mps2)
+                           max_mps2, self.blind_steady_mps, self.blind_band_m,
+                           self.blind_brake_factor)
 
     @classmethod
     def for_dialect(cls, dialect: Dialect, **overrides: object) -> SupervisorParams:

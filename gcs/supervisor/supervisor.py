@@ -463,7 +463,8 @@ class Supervisor:
         if self.alt_target_m is not None:
             self.alt_setpoint_m = self.alt_target_m
         floor = self.on_floor(est.alt_m) and self.alt_setpoint_m <= est.alt_m
-        sink = blind_sink_limit(est.alt_m - self.rest_alt_m, est.vel_mps, self._blind)
+        sink = blind_sink_limit(est.alt_m - self.rest_alt_m, est.vel_mps,
+                                est.alt_m - self.alt_setpoint_m, self._blind)
         self.alt = self.alt_ctrl.update(self.alt_setpoint_m, est, inp.roll_rad, inp.pitch_rad,
                                         inp.dt_s, on_floor=floor, rate_mps=self.alt_rate_mps,
                                         sink_limit_mps2=sink)

@@ -11,8 +11,8 @@ from gcs.supervisor.envelope import BlindFlight, blind_sink_limit, blind_touchdo
 from gcs.supervisor.params import SupervisorParams
 from tests.gcs.test_supervisor import REST_M, Script
 
-BLIND = BlindFlight(blind_s=2.5, brake_mps2=1.0, touchdown_mps=0.8, steady_mps=0.25,
-                    max_mps2=6.0)
+BLIND = BlindFlight(blind_s=2.5, brake_mps2=1.0, touchdown_mps=0.8, max_mps2=6.0,
+                    steady_mps=0.25, band_m=0.1, brake_factor=1.5)
 
 
 def simulated_touchdown(h: float, w: float, a: float, b: BlindFlight, dt: float = 1e-4) -> float:
@@ -40,28 +40,42 @@ def test_touchdown_matches_a_stepped_fall(h: float, w: float, a: float) -> None:
 @pytest.mark.parametrize(("h", "w"), [(0.5, 0.0), (1.0, 0.0), (1.0, -0.1), (2.0, 0.1),
                                       (2.9, 0.0)])
 def test_the_limit_is_the_largest_sink_that_lands_at_the_bound(h: float, w: float) -> None:
-    a = blind_sink_limit(h, w, BLIND)
+    a = blind_sink_limit(h, w, 0.0, BLIND)
     assert 0.0 < a < 6.0
     assert simulated_touchdown(h, w, a, BLIND) <= BLIND.touchdown_mps + 0.01
     assert simulated_touchdown(h, w, a + 0.02, BLIND) > BLIND.touchdown_mps
 
 
 def test_a_1_m_hold_may_ask_about_a_third_of_a_m_per_s2_down() -> None:
-    a = blind_sink_limit(1.0, 0.0, BLIND)
+    a = blind_sink_limit(1.0, 0.0, 0.0, BLIND)
     assert a == pytest.approx(BLIND.touchdown_mps ** 2 / 2.0, abs=0.002)
 
 
-def test_never_demands_a_climb_and_opens_for_a_vehicle_that_must_be_stopped() -> None:
+def test_never_demands_a_climb_and_brakes_a_climb_by_where_it_would_stop() -> None:
     # sinking faster than the bound: nothing downward is allowed, nothing upward forced
-    assert blind_sink_limit(1.0, -0.2, BLIND) >= 0.0
-    assert blind_sink_limit(0.5, -0.2, BLIND) < blind_sink_limit(0.5, 0.0, BLIND)
-    steady = blind_sink_limit(1.0, 0.2, BLIND)
-    halfway = blind_sink_limit(1.0, 1.5 * BLIND.steady_mps, BLIND)
-    assert steady < halfway < 6.0
-    assert blind_sink_limit(1.0, 2.0 * BLIND.steady_mps, BLIND) == math.inf
-    assert blind_sink_limit(0.0, 0.0, BLIND) == math.inf
-    unbounded = BlindFlight(2.5, 1.0, math.inf, 0.25, 6.0)
-    assert blind_sink_limit(1.0, 0.0, unbounded) == math.inf
+    assert blind_sink_limit(1.0, -0.2, 0.0, BLIND) >= 0.0
+    assert blind_sink_limit(0.5, -0.2, 0.0, BLIND) < blind_sink_limit(0.5, 0.0, 0.0, BLIND)
+    # a sink past steady_mps opens the bound, by twice it to the PID's, wherever it is
+    assert blind_sink_limit(1.0, -0.2, 0.0, BLIND) == blind_sink_limit(1.0, -0.2, 0.3, BLIND)
+    assert (blind_sink_limit(1.0, -0.2, 0.0, BLIND)
+            < blind_sink_limit(1.0, -1.5 * BLIND.steady_mps, 0.0, BLIND) < 6.0)
+    assert blind_sink_limit(1.0, -2.0 * BLIND.steady_mps, 0.0, BLIND) == math.inf
+    steady = blind_sink_limit(1.0, 0.0, 0.0, BLIND)
+    # the steady hold's estimated wander (0.17 m/s, 2 cm over) stops in the band on the bound
+    assert blind_sink_limit(1.0, 0.17, 0.02, BLIND) == pytest.approx(
+        blind_sink_limit(1.0, 0.17, -0.5, BLIND))
+    assert simulated_touchdown(1.0, 0.17, blind_sink_limit(1.0, 0.17, 0.02, BLIND),
+                               BLIND) <= BLIND.touchdown_mps + 0.01
+    # a real climb gets brake_factor times what stops it within band_m over the setpoint
+    assert blind_sink_limit(1.0, 0.4, 0.0, BLIND) == pytest.approx(1.5 * 0.16 / 0.2)
+    assert blind_sink_limit(1.0, 0.4, 0.05, BLIND) == pytest.approx(1.5 * 0.16 / 0.1)
+    assert steady < blind_sink_limit(1.0, 0.4, 0.0, BLIND) < 6.0
+    # past the band, or too fast for the PID to stop within it: all the braking there is
+    assert blind_sink_limit(1.0, 0.3, 0.12, BLIND) == math.inf
+    assert blind_sink_limit(1.0, 0.9, 0.0, BLIND) == math.inf
+    assert blind_sink_limit(0.0, 0.0, 0.0, BLIND) == math.inf
+    unbounded = BlindFlight(2.5, 1.0, math.inf, 6.0, 0.25, 0.1, 1.5)
+    assert blind_sink_limit(1.0, 0.0, 0.0, unbounded) == math.inf
 
 
 def test_the_hold_clips_its_downward_command_to_the_envelope_and_not_its_climb() -> None:
@@ -72,7 +86,7 @@ def test_the_hold_clips_its_downward_command_to_the_envelope_and_not_its_climb()
     hover = ctrl.hover_stick_us()
     s.alt = 1.4  # the estimate says 0.4 m too high: the PID wants down hard
     outs = s.run(0.2)
-    limit = blind_sink_limit(1.4 - REST_M, 0.0, s.sup._blind)
+    limit = blind_sink_limit(1.4 - REST_M, 0.0, 0.4, s.sup._blind)
     assert s.sup.alt is not None
     assert s.sup.alt.accel_cmd_mps2 == pytest.approx(-limit, abs=1e-6)
     assert s.sup.alt.saturated
@@ -106,13 +120,19 @@ def test_a_hover_learned_too_high_keeps_the_integrator_s_trim_below_it() -> None
         ctrl.pid.shift_integrator(trim)
         s.alt = 1.4
         s.tick()
-        limit = blind_sink_limit(1.4 - REST_M, 0.0, s.sup._blind)
+        limit = blind_sink_limit(1.4 - REST_M, 0.0, 0.4, s.sup._blind)
         assert s.sup.alt is not None
         assert s.sup.alt.accel_cmd_mps2 == pytest.approx(floor_at - limit, abs=0.01)
 
 
-@pytest.mark.parametrize("field", ["blind_s", "blind_steady_mps", "blind_touchdown_mps"])
+@pytest.mark.parametrize("field", ["blind_s", "blind_band_m", "blind_steady_mps",
+                                   "blind_touchdown_mps"])
 def test_a_zero_blind_setting_is_refused(field: str) -> None:
     zero: dict[str, Any] = {field: 0.0}
     with pytest.raises(ValueError, match=field):
         SupervisorParams(**zero)
+
+
+def test_a_climb_braked_softer_than_it_needs_is_refused() -> None:
+    with pytest.raises(ValueError, match="blind_brake_factor"):
+        SupervisorParams(blind_brake_factor=0.9)

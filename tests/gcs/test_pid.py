@@ -197,3 +197,21 @@ def test_a_settled_profile_ahead_is_not_stepped_further_and_nothing_changes(seed
         a = fast.update(target, measurement, 0.025, slew_per_s=slew)
         b = ref.update(target, measurement, 0.025, slew_per_s=slew)
         assert repr(a) == repr(b)
+
+
+def test_a_raised_floor_bounds_the_correction_and_not_the_profile_s_own_braking() -> None:
+    gains = PidGains(kp=2.0, ki=0.0, kd=0.0, i_max=1.0, out_min=-6.0, out_max=6.0,
+                     setpoint_slew_per_s=1.0, setpoint_accel_per_s2=1.5, ff_accel=1.0)
+    pid = Pid(gains)
+    pid.update(0.0, 0.0, 0.025)
+    outs, shaped = [], 0.0
+    for _ in range(200):  # a 1 m move, tracked perfectly: only the feed-forward acts
+        terms = pid.update(1.0, shaped, 0.025, out_min=-0.3)
+        shaped = terms.shaped_target
+        outs.append(terms.out)
+    assert shaped == pytest.approx(1.0)
+    assert min(outs) < -1.4  # the profile's planned braking went through
+    # once it stands, a correction (the vehicle 1 m over) asks no more than the floor
+    terms = pid.update(1.0, 2.0, 0.025, out_min=-0.3)
+    assert terms.out == pytest.approx(-0.3)
+    assert terms.saturated
