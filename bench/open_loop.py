@@ -8,8 +8,9 @@ FS_GCS_TIMEOUT 2 s), then lands. Heights are the SITL's truth; the SITL runs on 
 station has given up, so the landing is seen.
 
 Prints per profile and fade: the peak height (median, worst, flights above setpoint + 0.3 m)
-and the touchdown speed (median, worst, flights over 1.0 m/s: the slope of the last 0.25 s
-above the floor), and the flights that never came down.
+the touchdown speed (median, worst, flights over 1.0 m/s: the slope of the last 0.25 s above the
+floor), the flights that never came down, and when the autopilot disarmed, counted from the
+fade's start (median, worst; its land detector, 0.1 s steps).
 
     .venv/bin/python bench/open_loop.py [--seeds 1-60] [--fade up,both]
 """
@@ -40,8 +41,9 @@ FLOOR_BAND_M = 0.03
 HELD_S = 10.0  # the hold's level: the median truth height over this long before the fade
 
 
-def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None]:
-    """(peak height after the fade began, on the setpoint's scale, touchdown speed or None)."""
+def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None, float | None]:
+    """(peak height after the fade began, on the setpoint's scale, touchdown speed or None,
+    seconds from the fade's start to the autopilot's disarm or None)."""
     options = SessionOptions(command="fly", profile=profile, seed=seed, record=False,
                              fix_failsafe=True)
     faults = {"fade": fade, "fade_start_s": FADE_START_S, "fade_s": FADE_S}
@@ -52,10 +54,14 @@ def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None]:
         # point
         with contextlib.suppress(FlightFailed):
             fly_session(session, FlightPlan(alt_m=SETPOINT_M, hold_s=45.0), pilot_signals=False)
+        state = session.sitl.sitl.sim.vehicle(1).autopilot.state
+        disarmed = None if state.armed else session.clock.now_s() - FADE_START_S
         end = session.clock.now_s() + AFTER_S
         while session.clock.now_s() < end and vehicle.truth is not None:
-            session.sitl.sitl.advance_to(session.clock.now_s() + 0.5)
+            session.sitl.sitl.advance_to(session.clock.now_s() + 0.1)
             vehicle.truth.reports()  # takes what arrived (nothing pumps it once fly is over)
+            if disarmed is None and not state.armed:
+                disarmed = session.clock.now_s() - FADE_START_S
         series = vehicle.truth_series()
     assert series is not None, "lockstep flies with the truth endpoint"
     t, alt = series.t_s, series.alt_m
@@ -68,10 +74,10 @@ def fly_fade(profile: str, fade: str, seed: int) -> tuple[float, float | None]:
     peak = SETPOINT_M + float(alt[after].max()) - held
     down = np.nonzero(after & (alt <= floor + FLOOR_BAND_M))[0]
     if not down.size:
-        return peak, None
+        return peak, None, disarmed
     t_c = t[down[0]]
     sel = (t >= t_c - 0.25) & (t <= t_c)
-    return peak, float(max(0.0, -np.polyfit(t[sel] - t_c, alt[sel], 1)[0]))
+    return peak, float(max(0.0, -np.polyfit(t[sel] - t_c, alt[sel], 1)[0])), disarmed
 
 
 def seed_range(text: str) -> list[int]:
@@ -89,17 +95,21 @@ def main() -> int:
     print(f"lockstep, 1.0 m hold, {FADE_S:g} s fade from t = {FADE_START_S:g} s, seeds "
           f"{seeds[0]}-{seeds[-1]}, truth heights")
     print(f"{'profile':8} {'fade':5} {'peak m med/max':>15} {'> +0.3 m':>8} "
-          f"{'touch m/s med/max':>18} {'> 1 m/s':>7} {'not down':>8}")
+          f"{'touch m/s med/max':>18} {'> 1 m/s':>7} {'not down':>8} {'disarm s med/max':>17}")
     for profile in ("apm25", "copter4"):
         for fade in args.fade.split(","):
             runs = [fly_fade(profile, fade, s) for s in seeds]
-            peaks = [p for p, _ in runs]
-            speeds = [v for _, v in runs if v is not None]
+            peaks = [p for p, _, _ in runs]
+            speeds = [v for _, v, _ in runs if v is not None]
+            offs = [d for _, _, d in runs if d is not None]
+            off = (f"{statistics.median(offs):.1f} / {max(offs):.1f}" if offs else "-")
+            off += "" if len(offs) == len(runs) else f" ({len(runs) - len(offs)} armed)"
             high = sum(p > SETPOINT_M + 0.3 for p in peaks)
             fast = sum(v > 1.0 for v in speeds)
             touch = (f"{statistics.median(speeds):.2f} / {max(speeds):.2f}" if speeds else "-")
             print(f"{profile:8} {fade:5} {statistics.median(peaks):7.2f} / {max(peaks):4.2f} "
-                  f"{high:8d} {touch:>18} {fast:7d} {len(runs) - len(speeds):8d}", flush=True)
+                  f"{high:8d} {touch:>18} {fast:7d} {len(runs) - len(speeds):8d} {off:>17}",
+                  flush=True)
     return 0
 
 

@@ -179,9 +179,10 @@ def _run_fly(argv: list[str], proxy: FaultProxy, case: FaultCase,
                 if word == "hold" and out["fault_wall"] is None:
                     w = proxy.schedule(case.direction, after_hold_s, case.duration_s,
                                        drop=case.drop, loss=case.loss, bitflip=case.bitflip)
-                    out["fault_wall"] = proxy.monotonic_at(w.start_s)
+                    fault_wall = proxy.monotonic_at(w.start_s)
+                    out["fault_wall"] = fault_wall
                     if case.kill:
-                        threading.Timer(max(0.0, out["fault_wall"] - time.monotonic()),
+                        threading.Timer(max(0.0, fault_wall - time.monotonic()),
                                         proc.kill).start()
 
     readers = [threading.Thread(target=read_stdout, daemon=True),

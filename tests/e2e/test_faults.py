@@ -11,9 +11,13 @@ What the station's policy promises: proof of life is any frame; a short gap hold
 command; a gap over ~1 s makes it request LAND for a few seconds, then stop heartbeats and
 overrides so the autopilot's own failsafe acts if the uplink is dead too; nothing resumes when
 the link returns. So for a lost link, one way or both: never above setpoint + 0.3 m, touchdown
-no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault, `fly` exits 3 with
-a reason line, and a station that cannot see the vehicle asks for LAND more than once (what it
-sent is read off the uplink by a tap in the proxy, whether the frames got through or not).
+no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault (where the uplink is
+dead, plus the descent at the firmware's LAND speed from any height the open-loop seconds
+climbed past the bound: in lockstep, apm25 fades that reached the ceiling disarmed 16.3 and
+16.6 s after the fault, against 9.3-13.9 s for the other 58 of 60; bench/open_loop.py), `fly`
+exits 3 with a reason line, and a station that cannot see the vehicle asks for LAND more than
+once (what it sent is read off the uplink by a tap in the proxy, whether the frames got through
+or not).
 With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m and exits 0.
 
 The matrix is flown once per session (a module fixture, only the selected cases), in real time
@@ -44,6 +48,10 @@ ROSE = "rose "  # the start of the problem line for a vehicle above that
 SANK = "touched down at "  # ...and for one that met the floor too fast
 MAX_TOUCHDOWN_MPS = 1.0
 DOWN_AND_DISARMED_S = 20.0
+# Both firmwares' LAND descends at LAND_SPEED, 50 cm/s by default: a vehicle the open-loop
+# seconds carried past the bound (reported, below) has that much further to come down before
+# its land detector can disarm it
+FIRMWARE_LAND_MPS = 0.5
 LOSSY_HOLD_M = 0.1
 # The hold before the fault must be a hold (the station's own tests fly it to a few cm RMS):
 # worse means the machine could not keep up with the run, and the fault tells nothing.
@@ -55,8 +63,10 @@ MIN_LAND_REQUESTS = 2  # "requests LAND (SET_MODE, repeated) for a few seconds"
 @pytest.fixture(scope="module")
 def flights(request: pytest.FixtureRequest) -> dict[FlightSpec, FlightResult | Exception]:
     """Every selected flight of this module, flown together."""
-    wanted = [item.callspec.params["spec"] for item in request.session.items
-              if item.module is request.module and hasattr(item, "callspec")]
+    wanted = [spec for item in request.session.items
+              if isinstance(item, pytest.Function) and item.module is request.module
+              and hasattr(item, "callspec")
+              and isinstance(spec := item.callspec.params["spec"], FlightSpec)]
     return run_many(wanted, after_hold_s=AFTER_HOLD_S)
 
 
@@ -72,15 +82,18 @@ def _problems(r: FlightResult) -> list[str]:
     if not r.max_over_setpoint_m <= MAX_OVER_SETPOINT_M:
         out.append(f"{ROSE}{r.max_over_setpoint_m:.2f} m over the setpoint")
     if c.lands:
+        limit_s = DOWN_AND_DISARMED_S
+        if c.direction is not Direction.DOWN:  # the firmware's failsafe flies the landing
+            limit_s += max(r.max_over_setpoint_m - MAX_OVER_SETPOINT_M, 0.0) / FIRMWARE_LAND_MPS
         down = r.touchdown_s
-        if down is None or down - r.fault_start_s > DOWN_AND_DISARMED_S:
-            out.append(f"not on the floor within {DOWN_AND_DISARMED_S:g} s of the fault")
+        if down is None or down - r.fault_start_s > limit_s:
+            out.append(f"not on the floor within {limit_s:.1f} s of the fault")
         speed = r.touchdown_speed_mps
         if speed is not None and not speed <= MAX_TOUCHDOWN_MPS:
             out.append(f"{SANK}{speed:.2f} m/s")
         off = r.disarm_s
-        if off is None or off - r.fault_start_s > DOWN_AND_DISARMED_S:
-            out.append(f"not disarmed within {DOWN_AND_DISARMED_S:g} s of the fault")
+        if off is None or off - r.fault_start_s > limit_s:
+            out.append(f"not disarmed within {limit_s:.1f} s of the fault")
         if r.exit_code != FLIGHT_FAILED_EXIT or not r.reason.startswith("quadgcs fly: "):
             out.append(f"fly exited {r.exit_code} with {r.reason!r}, expected "
                        f"{FLIGHT_FAILED_EXIT} and a reason line")
