@@ -21,6 +21,7 @@ from gcs.clock import Clock
 from gcs.errors import RuntimeFault
 from gcs.position_controller import PositionSetpoint
 from gcs.station import Station, StationSnapshot
+from gcs.supervisor import LinkHealth
 from planners.geometry import Vec3
 from planners.proximity import Facing, ProximityReading
 
@@ -192,6 +193,10 @@ class Craft:
         if target is None:
             return
         snap = self.snapshot()
+        if snap.link_health is not LinkHealth.OK:
+            # the estimate stopped with the telemetry: set beside motion capture it tells only
+            # how far the vehicle moved since, and the supervisor holds or lands it meanwhile
+            return
         offset = 0.0
         if snap.estimate is not None and snap.mocap is not None:
             offset = snap.estimate.alt_m + snap.mocap.pos_n[2]

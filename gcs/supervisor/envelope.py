@@ -18,7 +18,8 @@ braking that stops it `band_m` above the setpoint, `brake_factor` times over (th
 late), and a fade in those moments is as unbounded as it ever was; climbs are never bounded.
 The climb is the estimate's, whose velocity in a steady hold wanders to 0.15–0.2 m/s while the
 vehicle's stays under 0.13 m/s: braked by speed alone, that noise opened the bound to the PID's.
-Measured against the setpoint it asks a few tenths of a m/s², under the steady bound or near it.
+For that wander, near the setpoint, the braking a climb gets is a few tenths of a m/s², at or
+under the steady bound.
 A profile's own planned braking (a take-off's end) passes below the bound (gcs/pid.py). A sink
 past `steady_mps` opens the bound as before, by twice it to the PID's limit: bounding those
 moments put a lossy-link hold 0.106 m off its setpoint (1 of 60 seeds, apm25).

@@ -77,9 +77,10 @@ class SupervisorParams:
     blind_s: float = 2.5
     blind_brake_mps2: float = 1.0
     blind_touchdown_mps: float = 0.8
-    # A climb gets this many times the braking that stops it this far over the setpoint. 60
-    # seeds a profile: lossy-link holds stay within ±0.1 m and take-offs within 5 %; at twice
-    # over, the steady hold's noisier climbs still asked for touchdowns above 1.0 m/s
+    # A climb gets this many times the braking that stops it this far over the setpoint:
+    # lossy-link holds (60 seeds a profile) stay within ±0.1 m and take-offs (20) within 3.3 %;
+    # braked twice over, 2 of 17 000 steady-hold ticks still asked for a blind touchdown above
+    # 1.0 m/s (bench/blind_risk.py)
     blind_band_m: float = 0.1
     blind_brake_factor: float = 1.5
     # a sink faster than this opens the bound, by twice it to the PID's own limit
