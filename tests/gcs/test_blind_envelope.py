@@ -136,3 +136,20 @@ def test_a_zero_blind_setting_is_refused(field: str) -> None:
 def test_a_climb_braked_softer_than_it_needs_is_refused() -> None:
     with pytest.raises(ValueError, match="blind_brake_factor"):
         SupervisorParams(blind_brake_factor=0.9)
+
+
+def test_the_hold_brakes_a_climb_by_how_far_over_the_setpoint_it_is() -> None:
+    """The same climb at 0.17 m/s (a steady hold's estimated wander): 2 cm over the setpoint
+    it is held to the steady bound; 8 cm over, near the band's end, it gets more."""
+    asked = []
+    for over in (0.02, 0.08):
+        s = Script()
+        s.hovering(1.0)
+        s.sup.alt_ctrl.pid.reset_I()
+        s.alt, s.vel = 1.0 + over, 0.17
+        s.tick()
+        assert s.sup.alt is not None
+        asked.append(-s.sup.alt.accel_cmd_mps2)
+    steady = blind_sink_limit(1.02 - REST_M, 0.17, -1.0, SupervisorParams().blind(6.0))
+    assert asked[0] == pytest.approx(steady, abs=0.01)
+    assert asked[1] > steady + 0.3
