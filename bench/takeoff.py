@@ -26,6 +26,7 @@ from gcs.commands.fly import fly_session
 from gcs.config import StationConfig
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
+from gcs.scoring import takeoff_peak_m
 from gcs.session import SessionOptions
 from logs import open_recording
 
@@ -48,11 +49,9 @@ def overshoot_pct(profile: str, seed: int, alt_m: float, tmp: Path) -> float:
         else:
             truth.append((ns / 1e9, -msg["pos_n"]["z"]))
     t, h = (np.array(x) for x in zip(*truth, strict=True))
-    armed, hold, land = (moves[("arming", "manual")], moves[("takeoff", "hold")],
-                         moves[("hold", "vehicle")])
-    floor = float(np.median(h[t < armed]))
-    flying = h[(t > hold) & (t < land)] - floor + StationConfig().estimator.rest_alt_m
-    return float((flying.max() - alt_m) / alt_m * 100.0)
+    peak = takeoff_peak_m(t, h, moves[("arming", "manual")], moves[("takeoff", "hold")],
+                          moves[("hold", "vehicle")], StationConfig().estimator.rest_alt_m)
+    return (peak - alt_m) / alt_m * 100.0
 
 
 def main() -> int:

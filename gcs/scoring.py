@@ -28,6 +28,9 @@ TRUTH = "truth"
 ESTIMATE = "estimate"
 NONE = "none"
 MAX_TRUTH_AGE_S = 0.3  # three SIM_STATE periods at 10 Hz: a report older than this is missing
+# samples as recorded (lists) or as arrays: every function here takes them through np.asarray
+Floats = Sequence[float] | np.ndarray
+MaybeFloats = Sequence[float | None] | np.ndarray
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,7 +41,7 @@ class Series:
     alt_m: np.ndarray
 
     @staticmethod
-    def of(t_s: Sequence[float], alt_m: Sequence[float]) -> Series:
+    def of(t_s: Floats, alt_m: Floats) -> Series:
         return Series(np.asarray(t_s, dtype=float), np.asarray(alt_m, dtype=float))
 
     def between(self, t0_s: float, t1_s: float) -> Series:
@@ -101,7 +104,7 @@ class StepMetrics:
     band_m: float
 
 
-def distinct_reports(t_s: Sequence[float], alt_m: Sequence[float | None]) -> Series:
+def distinct_reports(t_s: Floats, alt_m: MaybeFloats) -> Series:
     """Per-tick samples of the latest report → one point per report, at its first tick.
 
     Two reports of a flying vehicle never carry bit-identical altitudes; a tick with the same
@@ -120,7 +123,7 @@ def distinct_reports(t_s: Sequence[float], alt_m: Sequence[float | None]) -> Ser
     return Series.of(out_t, out_a)
 
 
-def station_time(rx_s: Sequence[float], t_s: Sequence[float], alt_m: Sequence[float],
+def station_time(rx_s: Floats, t_s: Floats, alt_m: Floats,
                  window_s: float = 1.0) -> Series:
     """Reports stamped with the sender's clock (`t_s`) and received at `rx_s` on the station's,
     as a Series on the station's clock. Each is shifted by the smallest receive delay seen
@@ -162,9 +165,9 @@ def _setpoint_at(t_s: np.ndarray, tick_t_s: np.ndarray, setpoint_m: np.ndarray) 
 
 
 def score_hold(
-    tick_t_s: Sequence[float],
-    setpoint_m: Sequence[float],
-    est_alt_m: Sequence[float | None],
+    tick_t_s: Floats,
+    setpoint_m: Floats,
+    est_alt_m: MaybeFloats,
     truth: Series | None,
     max_age_s: float = MAX_TRUTH_AGE_S,
 ) -> HoldScore:
@@ -189,7 +192,7 @@ def score_hold(
     return HoldScore(NONE, ErrorStats.of(np.array([])), 0.0, 0.0)
 
 
-def truth_origin_m(ground_truth_alt_m: Sequence[float | None], rest_alt_m: float) -> float | None:
+def truth_origin_m(ground_truth_alt_m: MaybeFloats, rest_alt_m: float) -> float | None:
     """Offset to subtract from truth altitudes that start wherever the vehicle first reported
     (SIM_STATE's first fix): the median on the floor, where the centre of gravity stands at
     `rest_alt_m`. None without truth on the floor."""
@@ -197,6 +200,17 @@ def truth_origin_m(ground_truth_alt_m: Sequence[float | None], rest_alt_m: float
     if not g.size:
         return None
     return float(np.median(g)) - rest_alt_m
+
+
+def takeoff_peak_m(t_s: np.ndarray, truth_alt_m: np.ndarray, armed_s: float, flying_s: float,
+                   landing_s: float, rest_alt_m: float) -> float:
+    """The highest a take-off went on the station's scale: truth altitudes, from the floor the
+    vehicle stood on before `armed_s` (at `rest_alt_m`), between the hold taking the climb over
+    at `flying_s` and the landing asked at `landing_s`."""
+    origin = truth_origin_m(truth_alt_m[t_s < armed_s], rest_alt_m)
+    if origin is None:
+        raise ValueError("no truth on the floor before arming")
+    return float(truth_alt_m[(t_s > flying_s) & (t_s < landing_s)].max()) - origin
 
 
 def step_response(series: Series, t0_s: float, target_m: float, step_m: float,

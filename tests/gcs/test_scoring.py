@@ -17,6 +17,7 @@ from gcs.scoring import (
     distinct_reports,
     score_hold,
     step_response,
+    takeoff_peak_m,
     truth_origin_m,
 )
 
@@ -143,3 +144,14 @@ def test_step_that_never_settles_is_inf_and_overshoot_is_measured() -> None:
     assert math.isinf(m.settle_time_s)
     assert m.overshoot_pct == pytest.approx(20.0, abs=0.5)
     assert step_response(Series.of([], []), 0.0, 2.0, 1.0, 0.05, 0.5) is None
+
+
+def test_takeoff_peak_is_measured_from_the_floor_the_vehicle_stood_on() -> None:
+    t = np.arange(0.0, 10.0, 0.5)
+    # truth from the SITL's own origin, 0.2 m under the floor; armed at 2 s, the hold takes the
+    # climb over at 4 s and the landing is asked at 9 s; 1.2 above the floor before 4 s is the
+    # ramp, not the hold's
+    h = np.where(t < 3.0, 0.2, np.where(t < 4.0, 1.4, np.where(t < 6.0, 1.25, 1.2)))
+    assert takeoff_peak_m(t, h, 2.0, 4.0, 9.0, 0.06) == pytest.approx(1.05 + 0.06)
+    with pytest.raises(ValueError, match="no truth on the floor"):
+        takeoff_peak_m(t, h, 0.0, 4.0, 9.0, 0.06)
