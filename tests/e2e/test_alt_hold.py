@@ -72,7 +72,7 @@ def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str)
     steps, when the step counts as settled is decided by that wobble: in fresh-clone CI runs
     apm25's did not settle within 8 s, and copter4's settled at 10.1 s. Within ±10 cm it is the
     step's own response: the same stall in lockstep (tests/gcs/test_stalled_sitl.py, seeds
-    1-30) settled in 2.2-2.7 s (apm25) and 2.4-4.0 s (copter4), overshooting 14-27 %; here the
+    1-30) settled in 2.2-4.3 s (apm25) and 2.4-4.0 s (copter4), overshooting 14-45 %; here the
     machine places the stalls and the spread is wider (one fresh-clone run overshot 42 %)."""
     sitl = SitlProcess(["--tcp", "0", "--speedup", "2", "--seed", "3", "--profile", profile,
                         "--mocap-port", "0"], ROOT)
