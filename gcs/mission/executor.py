@@ -87,8 +87,12 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
             if clock is None:
                 vehicle.station.start()
         rec = _MultiRecording({s: session.vehicles[s].sink for s in sysids})
+        # Stamped on the stations' clock: in lockstep it is the simulation's, and a
+        # monotonic stamp would put the world minutes after the flight in the recording.
+        station_clock = crafts[sysids[0]].clock
         # the room's bounds are the planner's to know; the boxes in it only with the truth
-        rec.scene(time.monotonic(), mw.world.room, mw.world.obstacles if options.truth else ())
+        rec.scene(station_clock.now_s(), mw.world.room,
+                  mw.world.obstacles if options.truth else ())
         f = Team(spec, crafts, rec, EventLog(rec, progress))
         f.event(MissionEvent.SESSION_READY, detail=f"{len(crafts)} vehicle(s)")
         try:
@@ -120,7 +124,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
                                 books=books, duration_s=f.elapsed_s(),
                                 wall_s=time.monotonic() - wall0, recording=rec.path,
                                 path_length=path_length)
-        rec.put(SUMMARY, time.monotonic(), report.to_dict())
+        rec.put(SUMMARY, station_clock.now_s(), report.to_dict())
     if spec.planner is PlannerKind.RADIATION and outcome.products is not None \
             and outcome.products[1] is not None:
         report.metrics.update(write_radiation_products(spec, options, report, outcome.products))

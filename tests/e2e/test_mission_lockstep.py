@@ -24,11 +24,12 @@ def _run(out: Path, *extra: str) -> subprocess.CompletedProcess[str]:
         capture_output=True, text=True, timeout=120, check=False)
 
 
-def _flown(d: dict[str, Any]) -> tuple[list[Any], list[Any]]:
+def _flown(d: dict[str, Any]) -> tuple[list[Any], list[Any], list[float]]:
     rec = open_recording(d["recording"])
-    steps = [m for _, _, m in rec.messages([topics.STEP_EPBHA])]
+    steps = [(t, m) for _, t, m in rec.messages([topics.STEP_EPBHA])]
     sticks = [(t, m) for _, t, m in rec.messages(["/gcs/rc_override"])]
-    return steps, sticks
+    books = [t for _, t, _ in rec.messages([topics.SCENE, topics.SUMMARY])]
+    return steps, sticks, books
 
 
 @pytest.mark.e2e
@@ -48,6 +49,11 @@ def test_a_lockstep_mission_reaches_the_goal_and_a_seed_repeats_bit_for_bit(
     a, b = (_flown(d) for d in runs)
     assert a[0] and a[1]
     assert a == b  # every planner step and every override, at the same simulated times
+    # the world is drawn before the first step and the summary follows the last override, on
+    # the simulated time line (not the machine's clock, which would put them minutes off)
+    steps, sticks, (scene_t, summary_t) = a
+    assert scene_t <= steps[0][0]
+    assert sticks[-1][0] <= summary_t <= sticks[-1][0] + 5 * 10**9
     for key in ("duration_s", "steps", "path_length_m", "goal_error_m",
                 "truth_min_clearance_m"):
         assert runs[0][key] == runs[1][key], key
