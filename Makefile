@@ -3,6 +3,10 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+# The compiled SITL (sitl/native.py): rebuilt when a SITL source changes; with no C compiler
+# the build says so and the SITL runs interpreted.
+NATIVE := sitl/_native.json
+SITL_SOURCES := $(shell find sitl -name '*.py')
 
 .PHONY: run test lint bench clean
 
@@ -12,7 +16,10 @@ $(STAMP): pyproject.toml constraints.txt
 	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[dev]'
 	touch $(STAMP)
 
-run: $(STAMP)
+$(NATIVE): $(STAMP) $(SITL_SOURCES)
+	$(BIN)/python -m sitl.native_build build
+
+run: $(STAMP) $(NATIVE)
 	$(BIN)/quadgcs teleop
 
 # One BLAS thread: on two cores numpy's threaded linear algebra fights the test processes.
@@ -27,7 +34,7 @@ run: $(STAMP)
 #   neighbour their loops tick 0.1-0.2 s late and the vehicles fall out of the air; the
 #   starved-SITL test's stalls are its own; lockstep campaigns on two Ray workers take both
 #   cores.
-test: $(STAMP)
+test: $(STAMP) $(NATIVE)
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m pytest -q -n 2 --dist loadfile --durations=25 \
@@ -40,8 +47,9 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 
-bench: $(STAMP)
+bench: $(STAMP) $(NATIVE)
 	$(BIN)/quadgcs bench --all
 
 clean:
+	-test -x $(BIN)/python && $(BIN)/python -m sitl.native_build clean
 	rm -rf $(VENV) build *.egg-info .pytest_cache

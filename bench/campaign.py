@@ -2,7 +2,8 @@
 
 1. Lockstep speed: one `fly --lockstep` 30 s hold at 1 m (one vehicle, the SITL's full sensor
    set, 40 Hz streams, motion capture and truth), simulated seconds per CPU second of this
-   process, without and with the MCAP recording. Goal: >= 100x.
+   process, without and with the MCAP recording. Goal: >= 100x. With the compiled SITL
+   (`sitl.native`), the same again in a child process with it switched off.
 2. Campaign throughput: `--flights` (default 200) seeded 30 s hold flights as one grid
    campaign on an embedded local Ray with `--workers` (default 2) workers: flights per minute
    of wall time from the first task to the last row (Ray's start and stop apart, printed too).
@@ -12,12 +13,15 @@
    campaign beyond the CPU the runs themselves used.
 
     .venv/bin/python bench/campaign.py [--flights 200] [--scaling-flights 40] [--workers 2]
+                                       [--speed-only]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -31,6 +35,7 @@ from gcs.commands.fly import fly_session
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
 from gcs.session import SessionOptions
+from sitl import native
 
 HOLD_S = 30.0
 
@@ -102,14 +107,23 @@ def main() -> None:
     ap.add_argument("--flights", type=int, default=200)
     ap.add_argument("--scaling-flights", type=int, default=40)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--speed-only", action="store_true", help="part 1 alone")
     args = ap.parse_args()
 
-    print(f"1. lockstep flight: {HOLD_S:.0f} s hold at 1 m, 1 vehicle, full sensors, 40 Hz "
-          "streams, mocap + truth (best of 2)")
+    if not args.speed_only:
+        print(f"1. lockstep flight: {HOLD_S:.0f} s hold at 1 m, 1 vehicle, full sensors, 40 Hz "
+              "streams, mocap + truth (best of 2)")
+    print(f"   {native.describe()}:")
     for record in (False, True):
         sim_s, cpu_s, rms = lockstep_speed(record)
         print(f"   recording {'on ' if record else 'off'}: {sim_s:.1f} simulated s in "
               f"{cpu_s:.2f} CPU s = {sim_s / cpu_s:.0f}x (goal 100x); hold RMS {rms * 100:.2f} cm")
+    if args.speed_only:
+        return
+    if native.REASON is None:
+        sys.stdout.flush()
+        subprocess.run([sys.executable, __file__, "--speed-only"], check=True,
+                       env={**os.environ, native.ENV_SWITCH: "0"})
 
     big = campaign(args.flights, args.workers, first_seed=1)
     print(f"2. campaign: {big['flights']} seeded {HOLD_S:.0f} s hold flights on "

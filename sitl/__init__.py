@@ -1,5 +1,12 @@
 """The bundled simulated vehicle: physics, ArduCopter-like autopilot, sensors, MAVLink endpoints."""
 
+# ruff: noqa: E402  (the guard must run before the first submodule is imported)
+
+# Before any submodule: the compiled SITL is used only while it matches its sources.
+from sitl import native as _native
+
+_native.guard()
+
 from sitl.autopilot import AutopilotOptions, FlightMode, Profile
 from sitl.battery import BatteryState
 from sitl.params import ParamError, VehicleParams

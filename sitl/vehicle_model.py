@@ -67,11 +67,11 @@ class SimVehicle:
     def __init__(
         self,
         world: World,
-        params: VehicleParams | None = None,
         *,
+        rng: np.random.Generator,
+        params: VehicleParams | None = None,
         start_pos_n: Sequence[float] | None = None,
         yaw_rad: float = 0.0,
-        rng: np.random.Generator,
         noise: bool = True,
         start_hovering: bool = False,
         battery_used_mah: float = 0.0,

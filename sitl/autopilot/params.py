@@ -24,6 +24,7 @@ land when the battery failsafe trips.
 from __future__ import annotations
 
 import enum
+import importlib.resources
 import json
 import math
 import re
@@ -33,7 +34,8 @@ from pathlib import Path
 
 from sitl.autopilot.profile import AutopilotOptions, Profile
 
-FIRMWARE_DIR = Path(__file__).with_name("firmware")
+# By package, not `__file__`: compiled by mypyc (sitl.native) a module's `__file__` is off.
+FIRMWARE_DIR = Path(str(importlib.resources.files("sitl.autopilot") / "firmware"))
 FIRMWARE_FILES = {Profile.APM25: "arducopter-3.2.1.json", Profile.COPTER4: "arducopter-4.7.json"}
 
 
