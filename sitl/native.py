@@ -1,12 +1,13 @@
-"""The SITL's hot modules compiled to C by mypyc: the same source, about twice as fast.
+"""The SITL's hot modules compiled to C by mypyc: the same source, run as native code.
 
-A lockstep flight spends half its CPU in the SITL (physics, sensors, autopilot, telemetry
-packing), all scalar Python on typed classes, which mypyc turns into native code. The compiled
-SITL flies bit for bit the flight the interpreted one flies (a test compares the recordings).
+An interpreted lockstep flight spends about half its CPU in the SITL (physics, sensors,
+autopilot, telemetry packing), scalar Python on typed classes; compiled, the whole flight costs
+a quarter less CPU (`bench/campaign.py`). The compiled SITL flies bit for bit the flight the
+interpreted one flies (a test compares every byte it sends).
 
 - `python -m sitl.native_build build` compiles `COMPILED` in place (`make` does it) and writes
-  `MANIFEST`: each source's SHA-256 as compiled. No C compiler: it says so and the SITL runs
-  interpreted.
+  `MANIFEST`: each source's SHA-256 as compiled. No C compiler (or no mypyc): it says so and
+  the SITL runs interpreted.
 - At import (`sitl/__init__.py` calls `guard`) the compiled modules are used only while every
   source still matches the manifest; an edited source, or `QUADGCS_SITL_NATIVE=0`, puts a finder
   first that loads every `sitl` module from source. All or none: compiled modules call each
