@@ -137,10 +137,15 @@ def compiled(module: ModuleType) -> bool:
     return origin.endswith(tuple(importlib.machinery.EXTENSION_SUFFIXES))
 
 
-def describe() -> str:
-    """One line for benches and reports: which SITL this process runs."""
+def build_kind() -> str:
+    """"compiled" or "interpreted": which SITL this process runs (its CPU times depend on it)."""
     import sitl.physics
 
-    if compiled(sitl.physics):
+    return "compiled" if compiled(sitl.physics) else "interpreted"
+
+
+def describe() -> str:
+    """One line for benches and reports: which SITL this process runs, and why."""
+    if build_kind() == "compiled":
         return "compiled SITL (mypyc)"
     return f"interpreted SITL ({REASON})" if REASON else "interpreted SITL"

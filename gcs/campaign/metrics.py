@@ -36,7 +36,7 @@ NUMERIC_METRICS: dict[str, str] = {
     "cpu_s": "CPU time of the run, s",
     "wall_s": "wall time of the run, s",
 }
-TEXT_METRICS = ("status", "reason", "error_source", "worker")
+TEXT_METRICS = ("status", "reason", "error_source", "worker", "sitl")
 COLUMNS = ("run_id", *TEXT_METRICS, *NUMERIC_METRICS)
 OK = "ok"
 FAILED = "failed"
@@ -46,7 +46,8 @@ def failed_row(run_id: str, values: dict[str, Any], reason: str) -> dict[str, An
     """A run that did not fly as commanded (or did not run): its reason, no numbers."""
     row: dict[str, Any] = {k: math.nan for k in NUMERIC_METRICS}
     row.update(values)
-    row.update(run_id=run_id, status=FAILED, reason=reason, error_source="none", worker="")
+    row.update(run_id=run_id, status=FAILED, reason=reason, error_source="none", worker="",
+               sitl="")
     return row
 
 

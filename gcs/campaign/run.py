@@ -20,6 +20,7 @@ from gcs.campaign.tables import set_dotted, station_table, world_table
 from gcs.config import config_from_table
 from gcs.flight import FlightPlan
 from gcs.session import SessionOptions
+from sitl import native
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,8 +105,10 @@ def failure_text(exc: Exception) -> str:
 
 
 def stamped(row: dict[str, Any], c0: float, w0: float) -> dict[str, Any]:
-    """The row with the run's CPU and wall time since (c0, w0) and the worker that ran it."""
+    """The row with the run's CPU and wall time since (c0, w0), the worker that ran it and
+    which SITL it flew (compiled or interpreted: the CPU time depends on it)."""
     row["cpu_s"] = time.process_time() - c0
     row["wall_s"] = time.perf_counter() - w0
     row["worker"] = f"{os.uname().nodename}:{os.getpid()}"
+    row["sitl"] = native.build_kind()
     return row

@@ -31,6 +31,7 @@ from gcs.campaign import (
 from gcs.cli import build_parser
 from gcs.commands.fly import fly
 from gcs.config import load_config
+from sitl import native
 
 RESULTS = "results.parquet"
 
@@ -96,8 +97,9 @@ def test_grid_results_resume_and_a_failing_run(tmp_path: Path, ray: Any) -> None
         assert r["status"] == "ok", r["reason"]
         assert r["error_source"] == "truth" and 0.0 < r["rms_error_m"] < 0.1
         assert r["sim_s"] > 15.0 and r["cpu_s"] > 0.0 and len(r["run_id"]) == 16
-    # two workers flew them
+    # two workers flew them, on the SITL this tree runs (compiled when make built it)
     assert len({r["worker"] for r in rows}) == 2
+    assert {r["sitl"] for r in rows} == {native.build_kind()}
     table = summary_table(rows, list(c.axes))
     assert len(table.splitlines()) == 3 and "rms_error_m median cm" in table
 

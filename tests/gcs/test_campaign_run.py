@@ -6,8 +6,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 from gcs.campaign.results import mission_summary_table
-from gcs.campaign.run import fly_run, make_run
+from gcs.campaign.run import RunSpec, fly_run, make_run
 from gcs.campaign.spec import BaseFlight
+from sitl import native
 
 
 def test_a_downlink_fade_in_the_hold_is_a_failed_row_naming_the_lost_link(tmp_path: Path
@@ -21,6 +22,7 @@ def test_a_downlink_fade_in_the_hold_is_a_failed_row_naming_the_lost_link(tmp_pa
     assert row["status"] == "failed" and row["link.fade"] == "down"
     assert "nothing heard from the vehicle for 1.5 s" in row["reason"]
     assert row["cpu_s"] > 0.0 and row["worker"]
+    assert row["sitl"] == native.build_kind() and row["sitl"] in ("compiled", "interpreted")
 
 
 class _Ref:
@@ -58,6 +60,7 @@ class InterruptedRay:
 def _row(run: object) -> dict:
     from gcs.campaign.metrics import flown_row
 
+    assert isinstance(run, RunSpec)
     return flown_row(run.run_id, run.values, {"rms_error_m": 0.01, "error_source": "truth"})
 
 
