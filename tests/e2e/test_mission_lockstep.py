@@ -24,7 +24,7 @@ def _run(out: Path, *extra: str) -> subprocess.CompletedProcess[str]:
         capture_output=True, text=True, timeout=120, check=False)
 
 
-def _flown(d: dict[str, Any]) -> tuple[list[Any], list[Any], list[float]]:
+def _flown(d: dict[str, Any]) -> tuple[list[Any], list[Any], list[int]]:
     rec = open_recording(d["recording"])
     steps = [(t, m) for _, t, m in rec.messages([topics.STEP_EPBHA])]
     sticks = [(t, m) for _, t, m in rec.messages(["/gcs/rc_override"])]
