@@ -1,8 +1,7 @@
 """The bundled simulated vehicle: physics, ArduCopter-like autopilot, sensors, MAVLink endpoints."""
 
-# ruff: noqa: E402  (the guard must run before the first submodule is imported)
-
-# Before any submodule: the compiled SITL is used only while it matches its sources.
+# ruff: noqa: E402  (before any submodule: the compiled SITL is used only while it matches
+# its sources, see sitl/native.py)
 from sitl import native as _native
 
 _native.guard()
