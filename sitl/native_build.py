@@ -3,8 +3,9 @@ they are used).
 
     python -m sitl.native_build build | clean | status
 
-`build` exits 0 when it compiled, or when this machine has no C compiler (it says so: the SITL
-then runs interpreted); 1 when mypyc or the compiler failed on our code, which `make` reports.
+`build` exits 0 when it compiled, or when this machine has no C compiler or no mypyc (it says
+so: the SITL then runs interpreted); 1 when mypyc or the compiler failed on our code, which
+`make` reports.
 """
 
 from __future__ import annotations
@@ -30,13 +31,16 @@ def _built_files(root: Path) -> list[Path]:
     return [p for p in (root / "sitl").rglob("*") if p.name.endswith(suffixes)]
 
 
+def _manifest(root: Path) -> Path:
+    return root / "sitl" / MANIFEST.name
+
+
 def clean(root: Path = ROOT) -> int:
     """Remove the compiled modules and the manifest; how many files went."""
     gone = _built_files(root)
     for p in gone:
         p.unlink()
-    if (root / "sitl" / MANIFEST.name).exists():
-        (root / "sitl" / MANIFEST.name).unlink()
+    _manifest(root).unlink(missing_ok=True)
     return len(gone)
 
 
@@ -46,8 +50,7 @@ def _compiler() -> str | None:
 
 
 def _write_manifest(root: Path, data: dict[str, object]) -> None:
-    (root / "sitl" / MANIFEST.name).write_text(json.dumps(data, indent=1) + "\n",
-                                               encoding="utf-8")
+    _manifest(root).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
 
 
 def build(root: Path = ROOT, jobs: int = 2) -> int:

@@ -29,7 +29,7 @@ def _manifest(root: Path, **fields: object) -> Path:
         "sources": {SOURCE: native.digest(root / SOURCE)},
     }
     data.update(fields)
-    path = root / "sitl" / "_native.json"
+    path = root / "sitl" / native.MANIFEST.name
     path.write_text(json.dumps(data), encoding="utf-8")
     return path
 
@@ -62,7 +62,7 @@ def test_why_the_sitl_runs_interpreted_is_said(tmp_path: Path, fields: dict[str,
 
 def test_a_missing_or_broken_manifest_means_interpreted(tmp_path: Path) -> None:
     root = _tree(tmp_path)
-    path = root / "sitl" / "_native.json"
+    path = root / "sitl" / native.MANIFEST.name
     assert "not built" in (native.why_interpreted(root, path, {}) or "")
     path.write_text("{not json", encoding="utf-8")
     assert "unreadable" in (native.why_interpreted(root, path, {}) or "")
@@ -75,8 +75,12 @@ def test_every_compiled_source_is_listed_and_no_package_init() -> None:
     assert all((native.ROOT / p).is_file() for p in files)
 
 
+def _why_not_built() -> str | None:
+    return native.why_interpreted(native.ROOT, native.MANIFEST, {})
+
+
 def _built() -> bool:
-    return native.why_interpreted(native.ROOT, native.MANIFEST, {}) is None
+    return _why_not_built() is None
 
 
 def _status(env: dict[str, str]) -> str:
@@ -105,7 +109,7 @@ def _fly(out: Path, env: dict[str, str]) -> list[tuple[str, int, bytes]]:
 
 
 @pytest.mark.e2e
-@pytest.mark.skipif(not _built(), reason="the compiled SITL is not built (no C compiler?)")
+@pytest.mark.skipif(not _built(), reason=f"no compiled SITL to compare: {_why_not_built()}")
 def test_the_compiled_sitl_flies_the_interpreted_flight_bit_for_bit(tmp_path: Path) -> None:
     fast = _fly(tmp_path / "compiled.mcap", {})
     slow = _fly(tmp_path / "interpreted.mcap", {native.ENV_SWITCH: "0"})
@@ -122,5 +126,5 @@ def test_with_no_compiler_the_build_says_so_and_the_sitl_runs_interpreted(
     monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
     assert native_build.build(root) == 0
     assert "no C compiler" in capsys.readouterr().out
-    why = native.why_interpreted(root, root / "sitl" / "_native.json", {})
+    why = native.why_interpreted(root, root / "sitl" / native.MANIFEST.name, {})
     assert why is not None and "no C compiler" in why
