@@ -48,7 +48,7 @@ from gcs.config import EstimatorKind
 from gcs.errors import QuadgcsError
 from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
 from gcs.scoring import score_hold
-from gcs.session import SessionOptions, StationSession, Vehicle
+from gcs.station.session import SessionOptions, StationSession, Vehicle
 
 # the real ArduCopter 4.7-dev SITL's onboard ALT_HOLD at 2 m for 60 s (ECOSYSTEM.md)
 REAL_ONBOARD_STD_CM = (0.15, 0.25)

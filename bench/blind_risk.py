@@ -32,11 +32,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from bench.open_loop import seed_range
 from firmware_link.records import Dialect
-from gcs.altitude_controller import AltitudeControllerParams
 from gcs.commands.fly import fly_session
+from gcs.control.altitude_controller import AltitudeControllerParams
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from gcs.supervisor.envelope import blind_touchdown
 from gcs.supervisor.params import SupervisorParams
 from logs import open_recording

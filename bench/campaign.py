@@ -34,7 +34,7 @@ from gcs.campaign import load_campaign, ray_session, run_campaign
 from gcs.commands.fly import fly_session
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from sitl import native
 
 HOLD_S = 30.0

@@ -7,8 +7,9 @@ starts. Height from motion capture (untouched by the fault), arming and mode fro
 UDP endpoint of the SITL.
 
 Faults: downlink lost 15 s; uplink lost 15 s; both ways lost 15 s; 30 % frame loss with 5 %
-bit flips both ways for 60 s; the station's process SIGKILLed (its guardian, gcs/guardian.py,
-takes the link over). `--serial` adds both-ways loss over the 115200-baud pty (apm25).
+bit flips both ways for 60 s; the station's process SIGKILLed (its guardian,
+gcs/station/guardian.py, takes the link over). `--serial` adds both-ways loss over the
+115200-baud pty (apm25).
 
 Columns: fault | profile | documented response | max height over setpoint | touchdown speed
 (vertical, just before contact) | time from the fault to disarm | fly's exit code; then the

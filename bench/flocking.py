@@ -23,15 +23,15 @@ import time
 
 import numpy as np
 
-from planners.flock_scenes import all_scenes
-from planners.flock_sim import (
+from planners.flocking.planner import FlockParams, FollowerPolicy
+from planners.flocking.scenes import all_scenes
+from planners.flocking.sim import (
     FlockResult,
     PlannerFactory,
     reynolds_factory,
     run_flock,
     triangular_factory,
 )
-from planners.flocking import FlockParams, FollowerPolicy
 
 MAX_STEPS = 1200
 SEED = 7

@@ -90,7 +90,7 @@ def hover_blocks(blocks: int, block_s: float, seed: int,
                  subscribe: str = "layout") -> list[tuple[bool, np.ndarray, dict]]:
     """Fly, then per block: (client connected?, the block's tick jitters in ms, client counts)."""
     from gcs.flight import FlightPlan, FlightRunner, Phase
-    from gcs.session import SessionOptions, StationSession
+    from gcs.station.session import SessionOptions, StationSession
 
     out: list[tuple[bool, np.ndarray, dict]] = []
     with tempfile.TemporaryDirectory(prefix="foxglove-bench-") as tmp:

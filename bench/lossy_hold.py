@@ -28,7 +28,7 @@ from gcs.commands.fly import fly_session
 from gcs.errors import FlightFailed
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 
 LOSS = 1.0 - 0.7 * 0.95
 LOSS_START_S = 40.0

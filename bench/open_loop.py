@@ -31,7 +31,7 @@ from gcs.commands.fly import fly_session
 from gcs.errors import FlightFailed
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 
 FADE_START_S = 40.0
 FADE_S = 15.0

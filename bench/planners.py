@@ -23,13 +23,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from planners.astar import plan_astar
-from planners.dstar_lite import run_dstar_lite
-from planners.epbha_run import run_epbha
+from planners.epbha.run import run_epbha
 from planners.kinematic import KinematicParams
 from planners.proximity import ProximityParams
 from planners.result import PlanResult
 from planners.scenes import Scene, random_room, thesis_scenes
+from planners.search.astar import plan_astar
+from planners.search.dstar_lite import run_dstar_lite
 
 MAX_STEPS = 3000
 BODY_RADIUS_M = KinematicParams().body_radius_m

@@ -30,13 +30,13 @@ sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
 
 import numpy as np  # noqa: E402
 
-from planners.lawnmower import Interpolation, run_lawnmower  # noqa: E402
 from planners.radiation import (  # noqa: E402
     RadiationMapperParams,
     RadiationResult,
     run_radiation,
 )
-from planners.radiation_field import RadiationField  # noqa: E402
+from planners.radiation.field import RadiationField  # noqa: E402
+from planners.radiation.lawnmower import Interpolation, run_lawnmower  # noqa: E402
 
 SPACINGS_M = (3.0, 2.5, 2.0, 1.75, 1.5, 1.25, 1.0, 0.8, 0.67, 0.5, 0.4)
 IOU_FLOOR = 0.85

@@ -27,7 +27,7 @@ from gcs.config import StationConfig
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
 from gcs.scoring import takeoff_peak_m
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from logs import open_recording
 
 TARGETS_M = (1.0, 2.0)

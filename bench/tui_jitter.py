@@ -13,7 +13,7 @@ import argparse
 import asyncio
 import time
 
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from gcs.tui import intents
 from gcs.tui.app import make_app
 from gcs.tui.process_backend import ProcessBackend

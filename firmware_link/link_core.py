@@ -164,7 +164,7 @@ class LinkCore(TransportUpkeep):
 
     def handoff(self) -> tuple[int, int, tuple | None] | None:
         """(transport generation, descriptor, UDP peer) of the open transport, for a process
-        that must be able to take the link over (`gcs.guardian`); None while there is none
+        that must be able to take the link over (`gcs.station.guardian`); None while there is none
         (being reopened). A new generation is a new transport, whatever its descriptor."""
         transport = self._ep.transport
         if transport is None:

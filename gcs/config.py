@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gcs.altitude_controller import AltitudeControllerParams
+from gcs.control.altitude_controller import AltitudeControllerParams
+from gcs.control.position_controller import PositionControllerParams
 from gcs.errors import UsageError
 from gcs.estimation import EstimatorParams
-from gcs.position_controller import PositionControllerParams
 from gcs.toml_file import read_toml
 
 

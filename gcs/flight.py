@@ -15,9 +15,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from firmware_link.records import FlightMode
+from gcs.control.position_controller import PositionSetpoint, yaw_from_quat
 from gcs.errors import FlightFailed
 from gcs.estimation import EstimatorCounts
-from gcs.position_controller import PositionSetpoint, yaw_from_quat
 from gcs.scoring import (
     ESTIMATE,
     TRUTH,
@@ -28,7 +28,7 @@ from gcs.scoring import (
     step_response,
 )
 from gcs.scoring import truth_origin_m as _truth_origin
-from gcs.station import Station, StationSnapshot
+from gcs.station.station import Station, StationSnapshot
 from gcs.supervisor import SupervisorState
 
 POLL_S = 0.1

@@ -21,8 +21,8 @@ from firmware_link.truth_link import TruthLink
 from gcs.config import StationConfig, load_config
 from gcs.errors import UsageError
 from gcs.lockstep import BundledLockstep, LockstepOptions, SteppedTruth, TeamClock
-from gcs.session import SCORED_COMMANDS, SessionOptions, StationSession
-from gcs.station import LAND_UNTIL, LAND_WAIT_STATES
+from gcs.station.session import SCORED_COMMANDS, SessionOptions, StationSession
+from gcs.station.station import LAND_UNTIL, LAND_WAIT_STATES
 
 LOCKSTEP_EPOCH_NS = 946_684_800 * 10**9
 """2000-01-01T00:00:00Z: where simulated time zero sits on a lockstep recording's timeline. A

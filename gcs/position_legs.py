@@ -13,11 +13,11 @@ import math
 from dataclasses import dataclass
 
 from gcs.config import StationConfig
+from gcs.control.position_controller import PositionSetpoint, yaw_from_quat
 from gcs.flight import FlightPlan, FlightRunner
 from gcs.lockstep_session import LockstepSession
-from gcs.position_controller import PositionSetpoint, yaw_from_quat
-from gcs.session import SessionOptions
-from gcs.station import StationSnapshot
+from gcs.station.session import SessionOptions
+from gcs.station.station import StationSnapshot
 from gcs.supervisor import SupervisorState
 
 

@@ -28,14 +28,14 @@ from typing import Any
 
 from firmware_link.records import Attitude, Barometer, Imu, MocapPose, Rangefinder
 from gcs import params_json, topics
-from gcs.altitude_controller import AltControlOutput, AltitudeController
 from gcs.config import StationConfig, _build
+from gcs.control.altitude_controller import AltControlOutput, AltitudeController
+from gcs.control.position_controller import PositionController
+from gcs.control.throttle_curve import ThrottleCurve
 from gcs.errors import UsageError
 from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
-from gcs.position_controller import PositionController
-from gcs.station import StationSetup, TickInputs
+from gcs.station.station import StationSetup, TickInputs
 from gcs.supervisor import Intent, Supervisor, SupervisorParams, TickIn, VehicleStatus
-from gcs.thrust_curve import ThrottleCurve
 from gcs.toml_file import read_toml
 from logs import Recording, RecordingError, from_jsonable
 

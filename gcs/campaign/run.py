@@ -19,7 +19,7 @@ from gcs.campaign.spec import BaseFlight, BaseMission
 from gcs.campaign.tables import set_dotted, station_table, world_table
 from gcs.config import config_from_table
 from gcs.flight import FlightPlan
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from sitl import native
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 
 
 def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:

@@ -27,8 +27,8 @@ from gcs.clock import Clock
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
 from gcs.errors import FlightFailed, UsageError
 from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
-from gcs.session import StationSession
-from gcs.station import StationSnapshot
+from gcs.station.session import StationSession
+from gcs.station.station import StationSnapshot
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
 from gcs.errors import UsageError
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 
 if TYPE_CHECKING:
     from gcs.gamepad.driver import Gamepad

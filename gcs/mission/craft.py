@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 from firmware_link.records import MocapPose, Proximity, Radiation, SimTruth
 from gcs.clock import Clock
+from gcs.control.position_controller import PositionSetpoint
 from gcs.errors import RuntimeFault
-from gcs.position_controller import PositionSetpoint
-from gcs.station import Station, StationSnapshot
+from gcs.station.station import Station, StationSnapshot
 from gcs.supervisor import LinkHealth
 from planners.geometry import Vec3
 from planners.proximity import Facing, ProximityReading

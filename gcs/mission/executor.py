@@ -37,7 +37,7 @@ from gcs.mission.team import Team
 from gcs.mission.team_port import TeamPort
 from gcs.mission.truth_check import check_contacts
 from gcs.mission.world import MissionWorld
-from gcs.session import SessionOptions, StationSession
+from gcs.station.session import SessionOptions, StationSession
 
 if TYPE_CHECKING:
     from gcs.lockstep_session import LockstepSession

@@ -27,7 +27,7 @@ from gcs.mission.recording import MissionRecording
 from gcs.mission.report import MissionReport, RunMode
 from gcs.mission.spec import MissionSpec
 from gcs.mission.world import MissionWorld
-from planners.flocking import FlockMission, FlockPlanner
+from planners.flocking.planner import FlockMission, FlockPlanner
 from planners.geometry import Vec3
 from planners.kinematic import KinematicParams, KinematicSim
 from planners.proximity import ProximityParams

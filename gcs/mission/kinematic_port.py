@@ -22,12 +22,12 @@ from gcs.mission.port import Count
 from gcs.mission.recording import MissionRecording
 from gcs.mission.report import RunMode
 from gcs.mission.spec import MissionSpec
-from planners.flock_sim import FlockRunParams, pairwise_min_m
+from planners.flocking.sim import FlockRunParams, pairwise_min_m
 from planners.geometry import Vec3
 from planners.kinematic import KinematicSim
 from planners.proximity import ProximityReading
 from planners.radiation import RadiationMapperParams, take_reading
-from planners.radiation_field import RadiationField
+from planners.radiation.field import RadiationField
 
 
 class KinematicPort:

@@ -15,7 +15,7 @@ from gcs.mission.planner_params import PlannerSetup
 from gcs.mission.port import ObstaclePort
 from gcs.mission.recording import STEP_EPBHA, epbha_payload, xyz
 from gcs.mission.report import MissionStatus
-from planners.epbha import Epbha, Status
+from planners.epbha.planner import Epbha, Status
 from planners.geometry import Vec3
 
 LOOP = "epbha"

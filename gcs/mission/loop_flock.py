@@ -18,7 +18,7 @@ from gcs.mission.planner_params import PlannerSetup
 from gcs.mission.port import ObstaclePort
 from gcs.mission.recording import STEP_FLOCK, flock_payload
 from gcs.mission.report import MissionStatus
-from planners.flocking import FlockMission, FlockPlanner
+from planners.flocking.planner import FlockMission, FlockPlanner
 from planners.geometry import Vec3
 
 LOOP = "flock"

@@ -24,7 +24,7 @@ from gcs.mission.recording import SAMPLE_RADIATION, radiation_payload
 from gcs.mission.report import MissionStatus
 from planners.geometry import Vec3
 from planners.radiation import RadiationMapper, RadiationMapperParams
-from planners.radiation_field import RadiationField
+from planners.radiation.field import RadiationField
 
 LOOP = "radiation"
 TRAVEL_MPS = 0.5  # radiation legs: the timeout grows with the leg at this speed

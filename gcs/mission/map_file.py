@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 from shapely.geometry import MultiPolygon, Polygon
 
-from planners.contour import polygon_rings
 from planners.radiation import Evaluation, MapEstimate, RadiationMapperParams, evaluate_region
-from planners.radiation_field import RadiationField
+from planners.radiation.contour import polygon_rings
+from planners.radiation.field import RadiationField
 
 FORMAT = "quadgcs.radiation_map/1"
 

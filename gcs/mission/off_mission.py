@@ -8,7 +8,7 @@ quiet: the mission must stop there and say why, or it goes on commanding a vehic
 from __future__ import annotations
 
 from firmware_link.records import Battery, FlightMode, StatusText
-from gcs.station import StationSnapshot
+from gcs.station.station import StationSnapshot
 
 
 def off_mission(snap: StationSnapshot, t_airborne_s: float) -> str | None:

@@ -17,9 +17,9 @@ from typing import Any
 
 from gcs.errors import UsageError
 from gcs.mission.spec import MissionSpec, PlannerKind
-from planners.epbha import EpbhaParams
-from planners.flocking import FlockParams
-from planners.formation import FormationParams
+from planners.epbha.planner import EpbhaParams
+from planners.flocking.formation import FormationParams
+from planners.flocking.planner import FlockParams
 from planners.radiation import RadiationMapperParams
 
 MISSION_KEYS: dict[str, type] = {

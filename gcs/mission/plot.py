@@ -14,8 +14,8 @@ from gcs.mission.map_file import write_map
 from gcs.mission.options import RunOptions
 from gcs.mission.report import MissionReport
 from gcs.mission.spec import MissionSpec
-from planners.contour import polygon_rings
-from planners.radiation_field import RadiationField
+from planners.radiation.contour import polygon_rings
+from planners.radiation.field import RadiationField
 
 
 def radiation_figure(path: Path, field: RadiationField | None, products: dict[str, Any],

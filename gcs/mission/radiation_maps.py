@@ -10,10 +10,10 @@ import numpy as np
 from gcs.mission.recording import CONTOUR, MAP_MEAN, MAP_VARIANCE, MissionRecording
 from gcs.mission.report import MissionStatus
 from logs import foxglove_grid
-from planners.contour import polygon_rings
 from planners.radiation import RadiationMapper, evaluate_region
-from planners.radiation_field import RadiationField
-from planners.tsp import path_length_m
+from planners.radiation.contour import polygon_rings
+from planners.radiation.field import RadiationField
+from planners.radiation.tsp import path_length_m
 
 MAP_CELL_M = 0.2  # recorded grids are decimated to this cell (the model's own is finer)
 

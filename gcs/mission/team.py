@@ -21,7 +21,7 @@ from gcs.mission.events import EventLog, MissionEvent
 from gcs.mission.off_mission import off_mission
 from gcs.mission.recording import MissionRecording
 from gcs.mission.spec import MissionSpec
-from gcs.station import StationSnapshot
+from gcs.station.station import StationSnapshot
 from gcs.supervisor import SupervisorState
 from planners.geometry import Vec3
 

@@ -14,7 +14,7 @@ from typing import Any
 
 from gcs.errors import UsageError
 from planners.geometry import Box, Vec3, World
-from planners.radiation_field import RadiationField
+from planners.radiation.field import RadiationField
 
 
 @dataclass(frozen=True, slots=True)

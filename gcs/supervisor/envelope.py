@@ -20,9 +20,10 @@ The climb is the estimate's, whose velocity in a steady hold wanders to 0.15–0
 vehicle's stays under 0.13 m/s: braked by speed alone, that noise opened the bound to the PID's.
 For that wander, near the setpoint, the braking a climb gets is a few tenths of a m/s², at or
 under the steady bound.
-A profile's own planned braking (a take-off's end) passes below the bound (gcs/pid.py). A sink
-past `steady_mps` opens the bound as before, by twice it to the PID's limit: bounding those
-moments put a lossy-link hold 0.106 m off its setpoint (1 of 60 seeds, apm25).
+A profile's own planned braking (a take-off's end) passes below the bound
+(gcs/control/pid.py). A sink past `steady_mps` opens the bound as before, by twice it to
+the PID's limit: bounding those moments put a lossy-link hold 0.106 m off its setpoint
+(1 of 60 seeds, apm25).
 """
 
 from __future__ import annotations

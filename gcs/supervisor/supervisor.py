@@ -23,9 +23,9 @@ from __future__ import annotations
 import math
 
 from firmware_link.records import FlightMode, RcCommand
-from gcs.altitude_controller import AltControlOutput, AltitudeController
+from gcs.control.altitude_controller import AltControlOutput, AltitudeController
+from gcs.control.position_controller import PositionCommand, PositionController, PositionSetpoint
 from gcs.estimation import SonarStatus
-from gcs.position_controller import PositionCommand, PositionController, PositionSetpoint
 from gcs.supervisor.envelope import blind_sink_limit
 from gcs.supervisor.params import SupervisorParams
 from gcs.supervisor.types import (

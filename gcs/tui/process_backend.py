@@ -19,7 +19,7 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 from gcs.errors import QuadgcsError, RuntimeFault, UsageError
-from gcs.session import SessionOptions, StationSession
+from gcs.station.session import SessionOptions, StationSession
 from gcs.tui import intents
 from gcs.tui.view import TeleopView
 

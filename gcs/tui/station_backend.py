@@ -13,7 +13,7 @@ from collections import deque
 
 from firmware_link.records import FlightMode, Rangefinder, SystemStatus
 from gcs.estimation import DeadReckoningEstimator
-from gcs.station import ControlMode, Station, StationSnapshot
+from gcs.station.station import ControlMode, Station, StationSnapshot
 from gcs.tui import intents
 from gcs.tui.sticks import stick_to_pwm
 from gcs.tui.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView

@@ -176,7 +176,7 @@ def _lands_safely(r: Run) -> None:
                          [("apm25", "tcp"), ("copter4", "tcp"), ("apm25", "serial")])
 def test_station_sigkilled_mid_air_is_landed_by_its_guardian(profile: str,
                                                              transport: str) -> None:
-    """Without its guardian (gcs/guardian.py) the vehicle flew the last override blind until
+    """Without its guardian (gcs/station/guardian.py) the vehicle flew the last override blind until
     its failsafe: up to 1.86 m from a 1 m hold, or into the floor at 1.02 m/s."""
     r = fly(profile, lambda proc, _p, _w: proc.send_signal(signal.SIGKILL),
             transport=transport, speedup=SPEEDUP if transport == "tcp" else 2.0)

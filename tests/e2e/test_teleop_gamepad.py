@@ -20,7 +20,7 @@ from gcs.gamepad.core import PadPhase
 from gcs.gamepad.driver import Gamepad
 from gcs.gamepad.mapping import load_mappings
 from gcs.gamepad.sdl_pad import SdlPad
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from gcs.tui.app import TeleopApp, make_app
 from gcs.tui.pad_panel import PadPanel
 from gcs.tui.process_backend import ProcessBackend

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from gcs.tui.app import make_app
 from gcs.tui.help import ConfirmQuit
 from gcs.tui.process_backend import ProcessBackend

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 from gcs.tui.app import make_app
 from gcs.tui.process_backend import ProcessBackend
 from gcs.tui.view import TeleopView

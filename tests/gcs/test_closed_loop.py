@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 from firmware_link.records import Attitude, Imu, Rangefinder
-from gcs.altitude_controller import AltitudeController, AltitudeControllerParams
 from gcs.config import StationConfig
+from gcs.control.altitude_controller import AltitudeController, AltitudeControllerParams
+from gcs.control.throttle_curve import CurveKind, ThrottleCurve
 from gcs.estimation import GRAVITY_MPS2, EstimatorParams, KalmanEstimator
-from gcs.thrust_curve import CurveKind, ThrottleCurve
 
 DT = 0.025
 HOVER = 0.5

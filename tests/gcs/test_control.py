@@ -10,17 +10,17 @@ import numpy as np
 import pytest
 
 from firmware_link.records import Dialect, MocapPose
-from gcs.altitude_controller import AltitudeController, AltitudeControllerParams
 from gcs.config import EstimatorKind, StationConfig, load_config
-from gcs.errors import UsageError
-from gcs.estimation import GRAVITY_MPS2, AltEstimate, SonarStatus
-from gcs.position_controller import (
+from gcs.control.altitude_controller import AltitudeController, AltitudeControllerParams
+from gcs.control.position_controller import (
     PositionController,
     PositionSetpoint,
     wrap_pi,
     yaw_from_quat,
 )
-from gcs.thrust_curve import CurveKind, ThrottleCurve
+from gcs.control.throttle_curve import CurveKind, ThrottleCurve
+from gcs.errors import UsageError
+from gcs.estimation import GRAVITY_MPS2, AltEstimate, SonarStatus
 
 
 def est(alt: float, vel: float = 0.0, t: float = 0.0) -> AltEstimate:

@@ -1,6 +1,7 @@
 """The guardian process against a small MAVLink vehicle on a real TCP socket or pseudo-terminal.
 
-The station's side is a real `VehicleLink`; the guardian is the real `python -m gcs.guardian`.
+The station's side is a real `VehicleLink`; the guardian is the real
+`python -m gcs.station.guardian`.
 A station process that dies closes its end of the guardian's socket without a word: the tests
 close it the same way (the kernel does nothing more when the process is killed).
 """
@@ -16,7 +17,7 @@ import pytest
 
 from firmware_link import VehicleLink, key_from_passphrase
 from firmware_link.records import FlightMode, LinkEvent, LinkEventKind
-from gcs.guardian import Guardian, GuardianSetup
+from gcs.station.guardian import Guardian, GuardianSetup
 from gcs.supervisor import SupervisorState
 from tests.firmware_link.peer import FakeVehicle, wait_until
 

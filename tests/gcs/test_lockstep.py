@@ -128,7 +128,7 @@ def test_a_lossy_radio_still_reads_the_preflight_parameters_and_flies(seed: int)
     from gcs.commands.fly import fly_session
     from gcs.flight import FlightPlan
     from gcs.lockstep_session import LockstepSession
-    from gcs.session import SessionOptions
+    from gcs.station.session import SessionOptions
 
     options = SessionOptions(command="fly", profile="apm25", seed=seed, record=False)
     with LockstepSession(options, faults={"loss": 0.2}) as session:
@@ -147,7 +147,7 @@ def test_a_hold_rides_out_a_minute_of_a_lossy_radio(seed: int) -> None:
     from gcs.commands.fly import fly_session
     from gcs.flight import FlightPlan
     from gcs.lockstep_session import LockstepSession
-    from gcs.session import SessionOptions
+    from gcs.station.session import SessionOptions
 
     start_s, lasting_s = 40.0, 60.0
     options = SessionOptions(command="fly", profile="apm25", seed=seed, record=False)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from gcs.clock import MonotonicClock, SimClock
-from gcs.loop import FixedRateLoop
+from gcs.station.loop import FixedRateLoop
 
 
 def test_ticks_start_on_absolute_deadlines_without_drift() -> None:

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from gcs.pid import Pid, PidGains
+from gcs.control.pid import Pid, PidGains
 
 GAINS = PidGains(kp=2.0, ki=1.0, kd=0.5, i_max=3.0, out_min=-5.0, out_max=5.0, d_filter_hz=5.0)
 

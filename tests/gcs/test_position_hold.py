@@ -15,14 +15,14 @@ from collections import deque
 import pytest
 
 from firmware_link.records import MocapPose
-from gcs.estimation import GRAVITY_MPS2
-from gcs.position_controller import (
+from gcs.control.position_controller import (
     AlphaBeta,
     PositionController,
     PositionSetpoint,
     SetpointProfile,
     lean_accel,
 )
+from gcs.estimation import GRAVITY_MPS2
 
 DT = 0.025
 ANGLE_MAX = math.radians(45.0)

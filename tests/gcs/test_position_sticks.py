@@ -7,7 +7,7 @@ import math
 import pytest
 
 from firmware_link.records import MocapPose
-from gcs.position_controller import (
+from gcs.control.position_controller import (
     PositionController,
     PositionControllerParams,
     PositionSetpoint,

@@ -26,7 +26,7 @@ from gcs.rerun import (
     parse_gains,
     rerun,
 )
-from gcs.station import Station, StationSetup, TickInputs
+from gcs.station.station import Station, StationSetup, TickInputs
 from logs import Recorder, open_recording
 from tests.gcs.test_station import FakeBoard
 

@@ -22,7 +22,7 @@ import pytest
 from gcs.commands.fly import fly_session
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
-from gcs.session import SessionOptions
+from gcs.station.session import SessionOptions
 
 
 def fly_stalled(profile: str, seed: int, stop_s: float = 0.3, every_s: float = 0.6,

@@ -23,11 +23,11 @@ from firmware_link.records import (
 )
 from gcs import topics
 from gcs.clock import MonotonicClock, SimClock
+from gcs.control.position_controller import PositionSetpoint
+from gcs.control.throttle_curve import ThrottleCurve
 from gcs.estimation import GRAVITY_MPS2
-from gcs.position_controller import PositionSetpoint
-from gcs.station import ControlMode, EventLevel, Station
+from gcs.station.station import ControlMode, EventLevel, Station
 from gcs.supervisor import SupervisorState
-from gcs.thrust_curve import ThrottleCurve
 
 REST_M = 0.06  # the station's default vehicle geometry
 SONAR_BELOW_CG_M = 0.05

@@ -7,9 +7,10 @@ import math
 import pytest
 
 from firmware_link.records import Dialect, FlightMode, MocapPose
-from gcs.altitude_controller import AltitudeController, AltitudeControllerParams
+from gcs.control.altitude_controller import AltitudeController, AltitudeControllerParams
+from gcs.control.position_controller import PositionController, PositionControllerParams
+from gcs.control.throttle_curve import ThrottleCurve
 from gcs.estimation import AltEstimate, SonarStatus
-from gcs.position_controller import PositionController, PositionControllerParams
 from gcs.supervisor import (
     ActionKind,
     Intent,
@@ -22,7 +23,6 @@ from gcs.supervisor import (
     VehicleStatus,
 )
 from gcs.supervisor import SupervisorState as S
-from gcs.thrust_curve import ThrottleCurve
 
 DT = 0.025
 REST_M = 0.06

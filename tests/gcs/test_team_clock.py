@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from gcs.lockstep import LockstepClock, TeamClock
-from gcs.loop import FixedRateLoop
+from gcs.station.loop import FixedRateLoop
 
 
 class Timeline:

@@ -9,7 +9,7 @@ import pytest
 from gcs.errors import UsageError
 from gcs.mission.planner_params import planner_setup
 from gcs.mission.spec import load_mission
-from planners.flocking import FollowerPolicy
+from planners.flocking.planner import FollowerPolicy
 
 
 def spec_with(tmp_path: Path, planner: str) -> object:

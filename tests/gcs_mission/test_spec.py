@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
+from gcs.control.position_controller import PositionControllerParams
 from gcs.errors import UsageError
 from gcs.mission.spec import PlannerKind, load_mission
-from gcs.position_controller import PositionControllerParams
 
 GOOD = """\
 name = "table"

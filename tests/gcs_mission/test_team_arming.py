@@ -15,7 +15,7 @@ from gcs.errors import RuntimeFault
 from gcs.mission.events import EventLog, MissionEvent
 from gcs.mission.spec import load_mission
 from gcs.mission.team import AUTO_DISARM_MARGIN_S, Team
-from gcs.station_types import StationEvent
+from gcs.station.types import StationEvent
 from gcs.supervisor import SupervisorParams, SupervisorState
 
 MISSION = Path(__file__).resolve().parents[2] / "missions" / "flock_table.toml"

@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 
 from gcs.clock import MonotonicClock
-from gcs.loop import FixedRateLoop
+from gcs.station.loop import FixedRateLoop
 from logs import Recorder
 
 

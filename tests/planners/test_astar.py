@@ -4,10 +4,10 @@ from collections import deque
 
 import pytest
 
-from planners.astar import astar_search, plan_astar
 from planners.geometry import Box, World
-from planners.grid import DIRECTIONS, Grid, GridParams
 from planners.result import PlanStatus
+from planners.search.astar import astar_search, plan_astar
+from planners.search.grid import DIRECTIONS, Grid, GridParams
 
 ROOM = Box("room", (0.0, 0.0, -1.2), (2.0, 2.0, 0.0))
 

@@ -6,7 +6,13 @@ import numpy as np
 import pytest
 from shapely.geometry import Point
 
-from planners.contour import contour_lines, iou, points_inside, polygon_rings, region_above
+from planners.radiation.contour import (
+    contour_lines,
+    iou,
+    points_inside,
+    polygon_rings,
+    region_above,
+)
 
 AX = np.linspace(-6.0, 6.0, 241)
 

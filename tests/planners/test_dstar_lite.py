@@ -2,11 +2,11 @@
 
 import pytest
 
-from planners.astar import plan_astar
-from planners.dstar_lite import run_dstar_lite
 from planners.geometry import Box, World
 from planners.result import PlanStatus
 from planners.scenes import Scene, thesis_scenes
+from planners.search.astar import plan_astar
+from planners.search.dstar_lite import run_dstar_lite
 
 ROOM = Box("room", (0.0, 0.0, -1.2), (3.0, 2.0, 0.0))
 WALL = Box("wall", (1.4, 0.0, -1.2), (1.5, 1.4, 0.0))  # a gap at the east end

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from planners.epbha import (
+from planners.epbha.planner import (
     Epbha,
     EpbhaParams,
     Move,
@@ -13,7 +13,7 @@ from planners.epbha import (
     Reason,
     Status,
 )
-from planners.epbha_run import run_epbha
+from planners.epbha.run import run_epbha
 from planners.proximity import Facing, ProximityReading
 from planners.result import PlanStatus
 from planners.scenes import Scene, thesis_scenes

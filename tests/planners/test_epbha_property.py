@@ -5,12 +5,12 @@ import itertools
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from planners.astar import astar_search, plan_astar
-from planners.dstar_lite import run_dstar_lite
-from planners.epbha_run import run_epbha
+from planners.epbha.run import run_epbha
 from planners.geometry import Box, World
-from planners.grid import Grid
 from planners.result import PlanStatus
+from planners.search.astar import astar_search, plan_astar
+from planners.search.dstar_lite import run_dstar_lite
+from planners.search.grid import Grid
 from tests.planners.test_astar import bfs_steps
 
 ROOM = Box("room", (0.0, 0.0, -1.6), (3.0, 2.0, 0.0))

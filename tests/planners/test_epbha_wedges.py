@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from planners.epbha import EpbhaParams, Move
-from planners.epbha_run import run_epbha
-from planners.epbha_wedges import wedge_clear, wedge_edges
+from planners.epbha.planner import EpbhaParams, Move
+from planners.epbha.run import run_epbha
+from planners.epbha.wedges import wedge_clear, wedge_edges
 from planners.geometry import Box, World
 from planners.kinematic import KinematicParams
 from planners.proximity import Facing, ProximityReading

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from planners.flock_scenes import FlockScene, open_hall, table_room
-from planners.flock_sim import FlockPlannerKind, run_flock
-from planners.flocking import FlockMission, FlockPlanner, Phase, VehicleMode
-from planners.formation import Role
+from planners.flocking.formation import Role
+from planners.flocking.planner import FlockMission, FlockPlanner, Phase, VehicleMode
+from planners.flocking.scenes import FlockScene, open_hall, table_room
+from planners.flocking.sim import FlockPlannerKind, run_flock
 from planners.geometry import Box, World
 from planners.proximity import ProximityReading
 from planners.result import PlanStatus

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from planners.flock_comm import OpenLoopChannel, send_rule
-from planners.flocking import FlockMission, FlockParams, FlockPlanner, LeaderAvoider
+from planners.flocking.comm import OpenLoopChannel, send_rule
+from planners.flocking.planner import FlockMission, FlockParams, FlockPlanner, LeaderAvoider
 from planners.proximity import ProximityReading
 
 

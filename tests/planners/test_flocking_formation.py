@@ -5,7 +5,7 @@ import itertools
 import numpy as np
 import pytest
 
-from planners.formation import (
+from planners.flocking.formation import (
     Formation,
     FormationParams,
     Role,

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from planners.flock_scenes import narrow_opening
-from planners.flock_sim import FlockPlannerKind, run_flock
-from planners.flocking import FlockParams
+from planners.flocking.planner import FlockParams
+from planners.flocking.scenes import narrow_opening
+from planners.flocking.sim import FlockPlannerKind, run_flock
 from planners.result import PlanStatus
 
 

@@ -4,7 +4,7 @@ import tomllib
 
 import pytest
 
-from planners.flocking import FlockParams, FollowerPolicy, LeaderAvoider
+from planners.flocking.planner import FlockParams, FollowerPolicy, LeaderAvoider
 
 
 def test_toml_overrides_nest_and_parse_enums() -> None:

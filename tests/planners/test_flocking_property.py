@@ -4,9 +4,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from planners.flock_scenes import CRUISE_Z_M, ROOM, FlockScene
-from planners.flock_sim import FlockPlannerKind, run_flock
-from planners.flocking import FlockParams
+from planners.flocking.planner import FlockParams
+from planners.flocking.scenes import CRUISE_Z_M, ROOM, FlockScene
+from planners.flocking.sim import FlockPlannerKind, run_flock
 from planners.geometry import Box, World
 
 

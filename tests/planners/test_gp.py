@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from planners.gp import (
+from planners.radiation.gp import (
     GaussianProcess,
     GpHyper,
     fit_by_grid_search,

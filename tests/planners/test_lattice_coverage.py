@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from planners.lattice_coverage import Lattice, lattice_points, measure, table_9_1
+from planners.flocking.lattice_coverage import Lattice, lattice_points, measure, table_9_1
 
 
 @pytest.mark.parametrize(

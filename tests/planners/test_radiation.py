@@ -5,7 +5,6 @@ import math
 import numpy as np
 import pytest
 
-from planners.lawnmower import Interpolation, lawnmower_path, run_lawnmower
 from planners.radiation import (
     Phase,
     RadiationMapper,
@@ -15,7 +14,8 @@ from planners.radiation import (
     run_radiation,
     sampling_distance_m,
 )
-from planners.radiation_field import RadiationField
+from planners.radiation.field import RadiationField
+from planners.radiation.lawnmower import Interpolation, lawnmower_path, run_lawnmower
 
 # worlds/radiation_3src.toml: a 20 x 20 m floor, three equal sources, background 1 %.
 THREE = RadiationField.from_tuples(

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from planners.radiation_budget import (
+from planners.radiation.budget import (
     BudgetStep,
     budget_series,
     coverage_polygon,

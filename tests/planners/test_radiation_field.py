@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from planners.radiation_field import RadiationField, fit_point_sources
+from planners.radiation.field import RadiationField, fit_point_sources
 
 
 def test_rate_at_one_metre_is_the_source_strength_plus_background() -> None:

@@ -4,10 +4,10 @@ import math
 
 import pytest
 
-from planners.epbha_run import run_epbha
+from planners.epbha.return_memory import ReturnMemory
+from planners.epbha.run import run_epbha
 from planners.geometry import Box, World
 from planners.proximity import Facing, ProximityReading
-from planners.return_memory import ReturnMemory
 
 HALF = math.radians(22.5)
 

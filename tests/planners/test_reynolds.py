@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from planners.flock_scenes import open_hall
-from planners.flock_sim import FlockPlannerKind, run_flock
-from planners.flocking import FlockMission
+from planners.flocking.planner import FlockMission
+from planners.flocking.reynolds import ReynoldsPlanner
+from planners.flocking.scenes import open_hall
+from planners.flocking.sim import FlockPlannerKind, run_flock
 from planners.proximity import ProximityReading
-from planners.reynolds import ReynoldsPlanner
 
 
 def test_messages_are_n_times_n_minus_one_per_step() -> None:

@@ -5,7 +5,7 @@ import itertools
 import numpy as np
 import pytest
 
-from planners.tsp import heuristic_visit_order, path_length_m, shortest_visit_order
+from planners.radiation.tsp import heuristic_visit_order, path_length_m, shortest_visit_order
 
 
 def held_karp(start: np.ndarray, pts: np.ndarray, closed: bool) -> float:

@@ -1,0 +1,1 @@
+"""Grid search baselines for EPBHA: the grid, A* and D* Lite."""
