@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from firmware_link.errors import LinkError
 from gcs.commands import _help
 from gcs.errors import QuadgcsError
+from gcs.version import package_version
 
 COMMAND_MODULES: tuple[str, ...] = (
     "sitl",
@@ -36,6 +37,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="quadgcs",
         description="Ground-control station for small indoor quadrotors (MAVLink, ArduCopter).",
     )
+    parser.add_argument("--version", action="version",
+                        version=f"%(prog)s {package_version()}",
+                        help="print the installed version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND",
                                 help="what to do (quadgcs COMMAND --help for its flags)")
     for name in COMMAND_MODULES:
