@@ -14,8 +14,10 @@ from typing import Any
 
 from sitl.link.codec import messages
 from sitl.link.view import VehicleView
+from sitl.sensors.proximity import ProximityFacing
 
-FACINGS: tuple[int, ...] = (0, 2, 4, 6, 24, 25)  # front, right, back, left, up, down
+# The order the proximity model reads its sensors in, which is the cache's order.
+FACINGS: tuple[int, ...] = tuple(int(f) for f in ProximityFacing)
 MAV_DISTANCE_SENSOR_INFRARED = 2
 
 
