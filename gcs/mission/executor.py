@@ -23,16 +23,13 @@ from typing import TYPE_CHECKING, Any
 from gcs.errors import UsageError
 from gcs.mission.craft import Craft, CraftPhase
 from gcs.mission.events import EventLog, MissionEvent
-from gcs.mission.loop_epbha import fly_epbha
-from gcs.mission.loop_flock import fly_flock
-from gcs.mission.loop_radiation import fly_radiation
 from gcs.mission.options import RunOptions
-from gcs.mission.outcome import mission_report
+from gcs.mission.outcome import Outcome, mission_report
+from gcs.mission.planner_loop import fly_planner
 from gcs.mission.planner_params import PlannerSetup
-from gcs.mission.plot import write_radiation_products
 from gcs.mission.recording import SUMMARY, MissionRecording
 from gcs.mission.report import MissionReport, RunMode
-from gcs.mission.spec import MissionSpec, PlannerKind
+from gcs.mission.spec import MissionSpec
 from gcs.mission.team import Team
 from gcs.mission.team_port import TeamPort
 from gcs.mission.truth_check import check_contacts
@@ -46,8 +43,9 @@ Progress = Callable[[str], None]
 
 
 def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, options: RunOptions,
-                    progress: Progress | None) -> MissionReport:
-    """Fly the mission with one station per vehicle; the report (with truth-based collisions)."""
+                    progress: Progress | None) -> tuple[MissionReport, Outcome]:
+    """Fly the mission with one station per vehicle; the report (with truth-based collisions)
+    and the planner loop's outcome."""
     wall0 = time.monotonic()
     speedup = options.speedup if options.speedup is not None else spec.speedup
     if options.lockstep:
@@ -97,15 +95,9 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         f.event(MissionEvent.SESSION_READY, detail=f"{len(crafts)} vehicle(s)")
         try:
             hover = f.take_off()
-            first = hover[sysids[0]]
-            if spec.planner is PlannerKind.EPBHA:
-                outcome = fly_epbha(TeamPort(f), setup, first)
-            elif spec.planner is PlannerKind.FLOCKING:
-                outcome = fly_flock(TeamPort(f), setup, hover)
-            else:
-                truth = (mw.radiation_field(height_m=spec.takeoff_alt_m)
-                         if options.truth and mw.has_truth else None)
-                outcome = fly_radiation(TeamPort(f), setup, first, truth)
+            truth = (mw.radiation_field(height_m=spec.takeoff_alt_m)
+                     if options.truth and mw.has_truth else None)
+            outcome = fly_planner(TeamPort(f), setup, hover, truth)
             f.land()  # whatever `flight.land` says: closing the session releases the sticks
         except BaseException:
             for c in crafts.values():  # all at once; leaving the session waits for each LAND
@@ -125,10 +117,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
                                 wall_s=time.monotonic() - wall0, recording=rec.path,
                                 path_length=path_length)
         rec.put(SUMMARY, station_clock.now_s(), report.to_dict())
-    if spec.planner is PlannerKind.RADIATION and outcome.products is not None \
-            and outcome.products[1] is not None:
-        report.metrics.update(write_radiation_products(spec, options, report, outcome.products))
-    return report
+    return report, outcome
 
 
 def _truth_books(crafts: dict[int, Craft], mw: MissionWorld) -> tuple[int, dict[str, Any]]:

@@ -12,25 +12,26 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from gcs.errors import UsageError
 from gcs.mission.kinematic_port import KinematicPort
-from gcs.mission.loop_epbha import fly_epbha
-from gcs.mission.loop_flock import fly_flock
-from gcs.mission.loop_radiation import fly_radiation
-from gcs.mission.outcome import mission_report
+from gcs.mission.outcome import Outcome, mission_report
+from gcs.mission.planner_loop import fly_planner
 from gcs.mission.planner_params import PlannerSetup
 from gcs.mission.recording import MissionRecording
 from gcs.mission.report import MissionReport, RunMode
-from gcs.mission.spec import MissionSpec
+from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.world import MissionWorld
 from planners.flocking.planner import FlockMission, FlockPlanner
 from planners.geometry import Vec3
 from planners.kinematic import KinematicParams, KinematicSim
 from planners.proximity import ProximityParams
+from planners.radiation.field import RadiationField
+from worldfile import vehicle_start
 
 NOMINAL_SPEED_MPS = 0.5  # a 0.1 m grid step every 0.2 s, as the flock runner assumes
 RADIATION_SPEED_MPS = 1.0
@@ -43,11 +44,7 @@ def start_of(spec: MissionSpec, mw: MissionWorld, index: int) -> Vec3:
     v = spec.vehicles[index]
     if v.start_n is not None:
         return v.start_n
-    starts = mw.start_positions_n
-    if index < len(starts):
-        return starts[index]
-    base = starts[-1]  # as the SITL places extra vehicles: a row 1 m apart to the east
-    return (base[0], base[1] + float(index - len(starts) + 1), base[2])
+    return vehicle_start(mw.start_positions_n, index)
 
 
 def _at_altitude(p: Vec3, alt_m: float) -> Vec3:
@@ -60,13 +57,25 @@ def _books(collisions: int, truth: bool) -> tuple[int, dict[str, Any]]:
         (0, {"collision_source": "none"})
 
 
-def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
-                        rec: MissionRecording, progress: Progress | None,
-                        truth: bool = True) -> MissionReport:
-    """EPBHA from the take-off point to the goal with exact moves (the boxes are simulated
-    whatever `truth` says; without it they are neither recorded nor counted against)."""
-    wall0 = time.monotonic()
-    t0 = time.monotonic()
+Books = tuple[int, dict[str, Any], float | None]
+"""Collisions, the world's safety books and the path length a report takes (None: the path's)."""
+
+
+@dataclass(frozen=True, slots=True)
+class KinematicFlight:
+    """A mission's vehicles in the kinematic world, ready for its planner loop."""
+
+    port: KinematicPort
+    starts_n: dict[int, Vec3]
+    truth: RadiationField | None  # the field the map is scored against, when the run may know it
+    books: Callable[[Outcome], Books]
+
+
+def epbha_flight(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                 rec: MissionRecording, progress: Progress | None, truth: bool,
+                 t0: float) -> KinematicFlight:
+    """EPBHA from the take-off point with exact moves (the boxes are simulated whatever
+    `truth` says; without it they are neither recorded nor counted against)."""
     params = setup.params
     start = _at_altitude(start_of(spec, mw, 0), spec.takeoff_alt_m)
     # the nearest surface anywhere in each cone, as EPBHA's memory takes a reading to mean
@@ -75,24 +84,24 @@ def run_epbha_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
     sim = KinematicSim(mw.world, start, KinematicParams(), prox,
                        np.random.default_rng(setup.seed))
     rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
-    port = KinematicPort(spec, rec, {spec.vehicles[0].sysid: sim}, t0,
+    sysid = spec.vehicles[0].sysid
+    port = KinematicPort(spec, rec, {sysid: sim}, t0,
                          step_s=params.step_m / NOMINAL_SPEED_MPS, progress=progress)
-    outcome = fly_epbha(port, setup, start)
-    collisions, books = _books(sim.collisions, truth)
-    books["min_clearance_m"] = sim.min_clearance_m if truth else None
-    return mission_report(spec, RunMode.KINEMATIC, outcome, collisions=collisions,
-                          books=books, duration_s=port.elapsed_s(),
-                          wall_s=time.monotonic() - wall0, recording=rec.path)
+
+    def books(outcome: Outcome) -> Books:
+        collisions, kept = _books(sim.collisions, truth)
+        kept["min_clearance_m"] = sim.min_clearance_m if truth else None
+        return collisions, kept, None
+
+    return KinematicFlight(port, {sysid: start}, None, books)
 
 
-def run_flock_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
-                        rec: MissionRecording, progress: Progress | None,
-                        truth: bool = True) -> MissionReport:
+def flock_flight(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                 rec: MissionRecording, progress: Progress | None, truth: bool,
+                 t0: float) -> KinematicFlight:
     """The triangular flock with exact moves from its formation slots round the leader's start;
     the world keeps the safety books, reported only with `truth` (the boxes, and where the
     vehicles really were), the separation between vehicles always."""
-    wall0 = time.monotonic()
-    t0 = time.monotonic()
     goal = spec.goal_n
     assert goal is not None
     ids = [v.sysid for v in spec.vehicles]
@@ -114,30 +123,28 @@ def run_flock_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup
     rec.scene(t0, mw.world.room, mw.world.obstacles if truth else ())
     port = KinematicPort(spec, rec, sims, t0, step_s=setup.params.step_m / NOMINAL_SPEED_MPS,
                          progress=progress)
-    outcome = fly_flock(port, setup, starts)
-    obstacle = sum(s.collisions for s in sims.values())
-    collisions, books = _books(obstacle + port.vehicle_collisions, truth)
-    books.update({
-        "min_clearance_m": min(s.min_clearance_m for s in sims.values()) if truth else None,
-        "obstacle_collisions": obstacle if truth else None,
-        "vehicle_collisions": port.vehicle_collisions,
-    })
-    return mission_report(spec, RunMode.KINEMATIC, outcome, collisions=collisions,
-                          books=books, duration_s=port.elapsed_s(),
-                          wall_s=time.monotonic() - wall0, recording=rec.path,
-                          path_length=outcome.metrics["team_path_length_m"])
+
+    def books(outcome: Outcome) -> Books:
+        obstacle = sum(s.collisions for s in sims.values())
+        collisions, kept = _books(obstacle + port.vehicle_collisions, truth)
+        kept.update({
+            "min_clearance_m": min(s.min_clearance_m for s in sims.values()) if truth else None,
+            "obstacle_collisions": obstacle if truth else None,
+            "vehicle_collisions": port.vehicle_collisions,
+        })
+        return collisions, kept, outcome.metrics["team_path_length_m"]
+
+    return KinematicFlight(port, dict(starts), None, books)
 
 
-def run_radiation_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
-                            rec: MissionRecording, progress: Progress | None,
-                            truth: bool = True) -> tuple[MissionReport, Any]:
+def radiation_flight(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                     rec: MissionRecording, progress: Progress | None, truth: bool,
+                     t0: float) -> KinematicFlight:
     """The contour mapper over the world's analytic field, perfect position hold.
 
     The field is simulated whatever `truth` says; the map is scored against it only when the
     run may know it (`truth`, and a world that has [[sources]]). A sample point outside the
     room counts as a collision."""
-    wall0 = time.monotonic()
-    t0 = time.monotonic()
     p = setup.params
     field = mw.radiation_field(height_m=spec.takeoff_alt_m)
     known = field if truth and mw.has_truth else None
@@ -145,13 +152,39 @@ def run_radiation_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerS
     start: Vec3 = (float(xy[0]), float(xy[1]), -spec.takeoff_alt_m)
     sim = KinematicSim(mw.world, start)
     rec.scene(t0, mw.world.room, mw.world.obstacles)
-    port = KinematicPort(spec, rec, {spec.vehicles[0].sysid: sim}, t0,
-                         speed_mps=RADIATION_SPEED_MPS, field=field,
-                         rng=np.random.default_rng(setup.seed), progress=progress)
-    outcome = fly_radiation(port, setup, start, known)
-    outside = sum(not mw.world.in_room(q) for q in outcome.path_n)
-    report = mission_report(spec, RunMode.KINEMATIC, outcome, collisions=int(outside),
-                            books={}, duration_s=port.elapsed_s(),
+    sysid = spec.vehicles[0].sysid
+    port = KinematicPort(spec, rec, {sysid: sim}, t0, speed_mps=RADIATION_SPEED_MPS,
+                         field=field, rng=np.random.default_rng(setup.seed), progress=progress)
+
+    def books(outcome: Outcome) -> Books:
+        outside = sum(not mw.world.in_room(q) for q in outcome.path_n)
+        return int(outside), {}, outcome.metrics["path_length_m"]
+
+    return KinematicFlight(port, {sysid: start}, known, books)
+
+
+FlightBuilder = Callable[[MissionSpec, MissionWorld, PlannerSetup, MissionRecording,
+                          Progress | None, bool, float], KinematicFlight]
+
+FLIGHTS: dict[PlannerKind, FlightBuilder] = {
+    PlannerKind.EPBHA: epbha_flight,
+    PlannerKind.FLOCKING: flock_flight,
+    PlannerKind.RADIATION: radiation_flight,
+}
+"""How each planner kind's vehicles are placed in the kinematic world."""
+
+
+def run_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                  rec: MissionRecording, progress: Progress | None,
+                  truth: bool = True) -> tuple[MissionReport, Outcome]:
+    """Fly the mission in the kinematic world; its report and the loop's outcome."""
+    wall0 = time.monotonic()
+    t0 = time.monotonic()
+    flight = FLIGHTS[spec.planner](spec, mw, setup, rec, progress, truth, t0)
+    outcome = fly_planner(flight.port, setup, flight.starts_n, flight.truth)
+    collisions, books, path_length = flight.books(outcome)
+    report = mission_report(spec, RunMode.KINEMATIC, outcome, collisions=collisions,
+                            books=books, duration_s=flight.port.elapsed_s(),
                             wall_s=time.monotonic() - wall0, recording=rec.path,
-                            path_length=outcome.metrics["path_length_m"])
-    return report, outcome.products
+                            path_length=path_length)
+    return report, outcome

@@ -11,13 +11,10 @@ from typing import Any
 
 from gcs.errors import UsageError
 from gcs.mission.executor import run_on_vehicles
-from gcs.mission.kinematic import (
-    run_epbha_kinematic,
-    run_flock_kinematic,
-    run_radiation_kinematic,
-)
+from gcs.mission.kinematic import run_kinematic
 from gcs.mission.options import RunOptions
-from gcs.mission.planner_params import planner_setup
+from gcs.mission.outcome import Outcome
+from gcs.mission.planner_params import PlannerSetup, planner_setup
 from gcs.mission.plot import write_radiation_products
 from gcs.mission.recording import SUMMARY, MissionRecording
 from gcs.mission.report import MissionReport
@@ -53,7 +50,19 @@ def run_mission(spec: MissionSpec, options: RunOptions,
     if options.seed is not None:
         setup = dataclasses.replace(setup, seed=options.seed)
     if not options.kinematic:
-        return run_on_vehicles(spec, mw, setup, options, progress)
+        report, outcome = run_on_vehicles(spec, mw, setup, options, progress)
+    else:
+        report, outcome = _run_kinematic(spec, mw, setup, options, progress)
+    if spec.planner is PlannerKind.RADIATION and outcome.products is not None \
+            and outcome.products[1] is not None:
+        report.metrics.update(write_radiation_products(spec, options, report, outcome.products))
+    return report
+
+
+def _run_kinematic(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup,
+                   options: RunOptions,
+                   progress: Callable[[str], None] | None) -> tuple[MissionReport, Outcome]:
+    """The kinematic world, recorded (and shown live) as the options ask."""
     with contextlib.ExitStack() as stack:
         live = None
         if options.foxglove is not None:  # opened first, closed last: it gets every message
@@ -68,16 +77,6 @@ def run_mission(spec: MissionSpec, options: RunOptions,
             if live is not None:
                 recorder.add_tap(live.publish)  # the recording's JSON, not encoded twice
         rec = MissionRecording(recorder if recorder is not None else live)
-        products: Any = None
-        if spec.planner is PlannerKind.EPBHA:
-            report = run_epbha_kinematic(spec, mw, setup, rec, progress, truth=options.truth)
-        elif spec.planner is PlannerKind.FLOCKING:
-            report = run_flock_kinematic(spec, mw, setup, rec, progress, truth=options.truth)
-        else:
-            report, products = run_radiation_kinematic(spec, mw, setup, rec, progress,
-                                                       truth=options.truth)
+        report, outcome = run_kinematic(spec, mw, setup, rec, progress, truth=options.truth)
         rec.put(SUMMARY, time.monotonic(), report.to_dict())
-    if spec.planner is PlannerKind.RADIATION and products is not None \
-            and products[1] is not None:
-        report.metrics.update(write_radiation_products(spec, options, report, products))
-    return report
+    return report, outcome

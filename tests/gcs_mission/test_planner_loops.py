@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from gcs.mission.events import EVENT, MissionEvent
-from gcs.mission.kinematic import run_flock_kinematic, start_of
+from gcs.mission.kinematic import run_kinematic, start_of
 from gcs.mission.kinematic_port import KinematicPort
 from gcs.mission.loop_epbha import fly_epbha
 from gcs.mission.loop_flock import fly_flock
@@ -142,7 +142,7 @@ def test_a_failsafe_during_a_count_drops_the_sample_and_ends_the_mapping() -> No
 
 def test_the_flock_loop_brings_the_team_home_and_stops_for_a_lost_teammate() -> None:
     spec, mw, setup = _load("flock_table")
-    home = run_flock_kinematic(spec, mw, setup, MissionRecording(None), None)
+    home, _ = run_kinematic(spec, mw, setup, MissionRecording(None), None)
     assert home.reached and home.metrics["planner_loop"] == "flock"
     assert home.duration_s == 0.2 * home.steps
     ids = [v.sysid for v in spec.vehicles]
