@@ -44,6 +44,7 @@ from logs.foxglove import (
     scene_sphere,
 )
 from logs.topics import LOG_TOPIC, TF_TOPIC
+from worldfile import WorldFileError, load_world_file
 
 POSE_ESTIMATE = "/gcs/pose/estimate"
 POSE_MOCAP = "/gcs/pose/mocap"
@@ -84,11 +85,12 @@ def world_boxes(path: Path | None) -> list[SceneBox]:
     """The world file's room and boxes for the 3D view (none without a file)."""
     if path is None or not Path(path).is_file():
         return []
-    from gcs.mission.world import load_world
-
-    world = load_world(Path(path)).world
-    return [SceneBox(world.room.min_n, world.room.max_n, ROOM_COLOR, id="room")] + [
-        SceneBox(b.min_n, b.max_n, id=b.name) for b in world.obstacles]
+    try:
+        world = load_world_file(Path(path))
+    except WorldFileError as exc:
+        raise UsageError(str(exc)) from None
+    return [SceneBox(world.room_min_n, world.room_max_n, ROOM_COLOR, id="room")] + [
+        SceneBox(b.min_n, b.max_n, id=b.name) for b in world.boxes]
 
 
 def quat_from_euler(roll_rad: float, pitch_rad: float, yaw_rad: float) -> tuple[float, ...]:

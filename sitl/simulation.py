@@ -26,6 +26,7 @@ from sitl.sensors import MocapSample
 from sitl.tick_record import tick_record
 from sitl.vehicle_model import SimVehicle
 from sitl.world import World, WorldError
+from worldfile import vehicle_start
 
 LOOP_RATE_HZ = 100.0
 BARO_RATE_HZ = 10.0
@@ -203,12 +204,7 @@ class Simulation:
         starts = world.start_positions_n
         self.vehicles: list[VehicleRuntime] = []
         for i in range(n_vehicles):
-            if i < len(starts):
-                start = starts[i]
-            else:
-                # more vehicles than start points: a row 1 m apart to the east of the last one
-                base = starts[-1]
-                start = (base[0], base[1] + float(i - len(starts) + 1), base[2])
+            start = vehicle_start(starts, i)
             self.vehicles.append(
                 VehicleRuntime(
                     i + 1, world, profile, start, rngs[i], noise, signing_key, options

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import ast
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -218,11 +218,64 @@ def test_cycle_finder_finds_a_cycle_and_only_it() -> None:
     assert cycles(graph) == [["a", "b", "c"]]
 
 
+# Findings not yet fixed, each to go (#32); a new finding fails at once, a fixed one must leave
+# this list (the strict xfail below turns green only when both lists are empty).
+KNOWN_ARROWS: frozenset[str] = frozenset({
+    # an optional CRC accelerator with a pure fallback, pinned in constraints.txt only
+    "firmware_link/frame_reader.py:27: fastcrc.crc16 is neither stdlib nor declared",
+    "firmware_link/frame_reader.py:27: fastcrc.crc16.mcrf4xx is neither stdlib nor declared",
+    "sitl/link/packer.py:21: fastcrc.crc16 is neither stdlib nor declared",
+    "sitl/link/packer.py:21: fastcrc.crc16.mcrf4xx is neither stdlib nor declared",
+    # textual's own dependency, imported directly
+    "gcs/tui/app.py:14: rich.text is neither stdlib nor declared",
+    "gcs/tui/app.py:14: rich.text.Text is neither stdlib nor declared",
+    "gcs/tui/pad_panel.py:5: rich.text is neither stdlib nor declared",
+    "gcs/tui/pad_panel.py:5: rich.text.Text is neither stdlib nor declared",
+    "gcs/tui/widgets.py:5: rich.text is neither stdlib nor declared",
+    "gcs/tui/widgets.py:5: rich.text.Text is neither stdlib nor declared",
+    # the lockstep and campaign code, to move into lab/
+    "gcs/campaign/run.py:23: gcs may not import sitl",
+    "gcs/campaign/run.py:23: gcs may not import sitl.native",
+    "gcs/campaign/tables.py:57: gcs may not import sitl.lockstep",
+    "gcs/campaign/tables.py:62: gcs may not import sitl.lockstep",
+    "gcs/lockstep.py:90: gcs may not import sitl.lockstep",
+})
+KNOWN_CYCLES: frozenset[tuple[str, ...]] = frozenset({
+    ("firmware_link.memory", "firmware_link.transport"),
+    ("gcs.campaign.mission_run", "gcs.campaign.run", "gcs.campaign.spec"),
+    ("sitl", "sitl.simulation", "sitl.vehicle_model"),
+    ("sitl.autopilot", "sitl.autopilot.autopilot"),
+    ("sitl.fault_proxy", "sitl.fault_proxy_cli"),
+    ("sitl.link", "sitl.link.handler"),
+})
+
+
+def _lines(found: Iterable[object]) -> str:
+    return "\n".join(str(f) for f in found)
+
+
+def test_no_new_import_against_the_design() -> None:
+    bad = set(arrow_violations())
+    assert bad <= KNOWN_ARROWS, "imports against DESIGN.md's table:\n" + _lines(
+        sorted(bad - KNOWN_ARROWS))
+    gone = KNOWN_ARROWS - bad
+    assert not gone, "fixed: remove from KNOWN_ARROWS:\n" + _lines(sorted(gone))
+
+
+def test_no_new_import_cycle() -> None:
+    found = {tuple(c) for c in cycles(import_graph())}
+    assert found <= KNOWN_CYCLES, "import cycles:\n" + _lines(sorted(found - KNOWN_CYCLES))
+    gone = KNOWN_CYCLES - found
+    assert not gone, "fixed: remove from KNOWN_CYCLES:\n" + _lines(sorted(gone))
+
+
+@pytest.mark.xfail(strict=True, reason="#32: the KNOWN_ARROWS findings (undeclared imports)")
 def test_every_package_imports_only_what_the_design_allows() -> None:
     bad = arrow_violations()
     assert not bad, "imports against DESIGN.md's table:\n" + "\n".join(bad)
 
 
+@pytest.mark.xfail(strict=True, reason="#32: lockstep and campaigns still in gcs")
 @pytest.mark.parametrize("package", ["gcs"])
 def test_the_station_never_reaches_the_sitl(package: str) -> None:
     bad = [
@@ -234,6 +287,7 @@ def test_the_station_never_reaches_the_sitl(package: str) -> None:
     assert not bad
 
 
+@pytest.mark.xfail(strict=True, reason="#32: the KNOWN_CYCLES (firmware_link, sitl)")
 def test_no_import_cycle() -> None:
     found = cycles(import_graph())
     assert not found, "import cycles:\n" + "\n".join(" <-> ".join(c) for c in found)

@@ -49,7 +49,6 @@ a world key through the SITL's (`check_world`).
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -58,7 +57,7 @@ from gcs.campaign.tables import check_faults, check_world, set_dotted, world_tab
 from gcs.config import config_from_table
 from gcs.errors import UsageError
 from gcs.flight import FlightPlan
-from gcs.toml_file import read_toml
+from worldfile import read_toml
 
 KINDS = ("grid", "random", "search")
 TOP_KEYS = {"name", "kind", "samples", "sample_seed", "fly", "mission", "axes", "search"}
@@ -246,9 +245,10 @@ def _base(p: Path, fly: Any) -> BaseFlight:
     _check_plan(p, "fly", base, {})
     if base.config_path is not None:
         try:
-            config_from_table(tomllib.loads(base.config_path.read_text(encoding="utf-8")))
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, UsageError) as exc:
-            raise _fail(p, "fly.config", f"{base.config}: {exc}") from None
+            config_from_table(read_toml(base.config_path, label=str(base.config),
+                                        noun="station config", error=UsageError))
+        except UsageError as exc:
+            raise _fail(p, "fly.config", str(exc)) from None
     _check_world(p, "fly.world", base.world_path, {})
     return base
 

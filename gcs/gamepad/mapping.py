@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from gcs.errors import UsageError
+from gcs.toml_file import read_toml
 
 AXIS_ROLES: tuple[str, ...] = ("roll", "pitch", "yaw", "throttle")
 BUTTON_ROLES: tuple[str, ...] = (
@@ -262,15 +263,7 @@ def parse_mapping(data: Mapping[str, Any], source: str,
 
 
 def _read(path: Path) -> dict[str, Any]:
-    try:
-        with path.open("rb") as f:
-            return tomllib.load(f)
-    except FileNotFoundError:
-        raise UsageError(f"gamepad map {path}: no such file") from None
-    except OSError as exc:
-        raise UsageError(f"gamepad map {path}: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UsageError(f"gamepad map {path}: not valid TOML: {exc}") from None
+    return read_toml(path, label=f"gamepad map {path}")
 
 
 def bundled_text() -> str:

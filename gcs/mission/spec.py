@@ -26,13 +26,13 @@ from __future__ import annotations
 
 import enum
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from gcs.config import StationConfig, config_from_table
 from gcs.errors import UsageError
+from worldfile import parse_toml
 
 Vec3 = tuple[float, float, float]
 
@@ -141,15 +141,13 @@ def load_mission(path: str | Path) -> MissionSpec:
     """Read and validate a mission file; raise UsageError with one line on any problem."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except FileNotFoundError:
         raise UsageError(f"{path}: no such mission file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UsageError(f"{path}: cannot read mission file ({exc})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise UsageError(f"{path}: not valid TOML ({exc})") from None
+    except OSError as exc:
+        raise UsageError(f"{path}: cannot read mission file ({exc.strerror or exc})") from None
+    data = parse_toml(raw, label=str(path), noun="mission file", error=UsageError)
+    text = raw.decode("utf-8")
     r = _Reader(path, text)
 
     name = data.get("name", path.stem)

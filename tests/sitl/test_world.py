@@ -141,7 +141,7 @@ BAD = [
     (ROOM + "[vehicle]\nmass_kg = 0.1\n", "vehicle.motor_mass_kg"),
     (ROOM + "[mocap]\nenabled = 1\n", "mocap.enabled: expected true or false"),
     (ROOM + "[radiation]\nbackground_cps = -1\n", "radiation.background_cps"),
-    ("name = [unclosed\n", "invalid TOML"),
+    ("name = [unclosed\n", "not valid TOML"),
 ]
 
 
