@@ -18,6 +18,7 @@ from firmware_link.records import FlightMode
 from gcs.control.position_controller import PositionSetpoint, yaw_from_quat
 from gcs.errors import FlightFailed
 from gcs.estimation import EstimatorCounts
+from gcs.launch import ARM_TIMEOUT_S, REST_S, Launch, LaunchRules, LaunchStage, vehicle_said
 from gcs.scoring import (
     ESTIMATE,
     TRUTH,
@@ -89,10 +90,10 @@ class FlightPlan:
     climb_mps: float = 0.5
     descent_mps: float = 0.3
     handover_alt_m: float = 0.15
-    arm_timeout_s: float = 40.0
+    arm_timeout_s: float = ARM_TIMEOUT_S
     # disarmed on the floor before arming, so the estimator learns the accelerometer's bias
     # from a vehicle known to stand still (over carpet it has to coast on it for up to 1.2 s)
-    rest_s: float = 3.0
+    rest_s: float = REST_S
     takeoff_delay_s: float = 0.0  # armed on the floor this long before taking off
 
     def __post_init__(self) -> None:
@@ -140,17 +141,47 @@ def _truth_alt(snap: StationSnapshot) -> float | None:
     return -snap.truth.pos_n[2] if snap.truth is not None else None
 
 
+class _FlyPort:
+    """How the launch looks and waits in a flight: every look checks the flight's phase; the
+    runner's idle (a sleep, or in lockstep one tick) between looks."""
+
+    def __init__(self, runner: FlightRunner) -> None:
+        self.runner = runner
+        self._last: StationSnapshot | None = None
+
+    def now_s(self) -> float:
+        return self.runner.station.clock.now_s()
+
+    def look(self, vehicle: int) -> StationSnapshot:
+        r = self.runner
+        snap = self._last = r.station.snapshot(loop_stats=False)
+        r.check(snap)
+        return snap
+
+    def idle(self) -> None:
+        r = self.runner
+        if r.on_progress is not None and self._last is not None:
+            r.on_progress(self._last, r.phase)
+        r.idle()
+
+    def rest(self, seconds: float) -> None:
+        self.runner.pause(seconds)
+
+    def told(self, stage: LaunchStage, detail: str) -> None:
+        pass  # a flight's progress lines come from its phases
+
+
 class FlightRunner:
     """Runs a `FlightPlan` on a started station from the calling thread."""
 
     def __init__(self, station: Station, plan: FlightPlan,
                  on_progress: Callable[[StationSnapshot, Phase], None] | None = None,
                  rest_alt_m: float | None = None,
-                 idle: Callable[[], None] | None = None) -> None:
+                 idle: Callable[[], None] | None = None, sysid: int = 1) -> None:
         self.station = station
         # between looks at the station: sleep while its loop thread flies, or (lockstep) run
         # its next tick, the simulation included
-        self._idle = idle or (lambda: time.sleep(POLL_S))
+        self.idle = idle or (lambda: time.sleep(POLL_S))
         # the truth's vertical origin is whatever the vehicle reported first; the flight starts
         # on the floor, where the centre of gravity is known to stand at rest_alt_m
         self.rest_alt_m = (station.config.estimator.rest_alt_m if rest_alt_m is None
@@ -158,12 +189,14 @@ class FlightRunner:
         self.plan = plan
         self.phase = Phase.GROUND
         self.samples: list[FlightSample] = []
-        self._on_progress = on_progress
+        self.on_progress = on_progress
         self._target: float | None = None
         # modes the vehicle may be in while armed; anything else (a failsafe LAND, say) ends
         # the flight with a clear message instead of scoring a flight nobody is flying
         self.expected_modes: set[int] = {FlightMode.STABILIZE}
         station.add_listener(self._sample)
+        self.launch = Launch({sysid: station}, _FlyPort(self),
+                             LaunchRules(rest_s=plan.rest_s, arm_timeout_s=plan.arm_timeout_s))
 
     def _sample(self, snap: StationSnapshot) -> None:
         est = snap.estimate
@@ -182,9 +215,9 @@ class FlightRunner:
         """The supervisor's last reason and the vehicle's recent words, for a failure line."""
         notes = [e.text for e in snap.events if e.text.startswith(f"{snap.state.value}:")]
         why = notes[-1] if notes else f"station {snap.state.value}"
-        return why + self._vehicle_said(snap)
+        return why + vehicle_said(snap)
 
-    def _check(self, snap: StationSnapshot) -> None:
+    def check(self, snap: StationSnapshot) -> None:
         if self.station.error is not None:
             raise FlightFailed(f"control loop stopped: {self.station.error}")
         allowed = PHASE_STATES.get(self.phase)
@@ -201,15 +234,15 @@ class FlightRunner:
         deadline = clock.now_s() + timeout_s
         while True:
             snap = self.station.snapshot(loop_stats=False)
-            self._check(snap)
+            self.check(snap)
             if pred(snap):
                 return
-            if self._on_progress is not None:
-                self._on_progress(snap, self.phase)
+            if self.on_progress is not None:
+                self.on_progress(snap, self.phase)
             if clock.now_s() >= deadline:
                 raise FlightFailed(f"{what} did not happen within {timeout_s:g} s "
                                    f"({self._why(snap)})")
-            self._idle()
+            self.idle()
 
     def pause(self, seconds: float) -> None:
         """Let `seconds` pass on the station's clock, watching for trouble."""
@@ -217,38 +250,16 @@ class FlightRunner:
         end = clock.now_s() + seconds
         while clock.now_s() < end:
             snap = self.station.snapshot(loop_stats=False)
-            self._check(snap)
-            if self._on_progress is not None:
-                self._on_progress(snap, self.phase)
-            self._idle()
+            self.check(snap)
+            if self.on_progress is not None:
+                self.on_progress(snap, self.phase)
+            self.idle()
 
     # -------------------------------------------------------------- the flight
     def arm(self) -> None:
-        """STABILIZE, throttle at minimum, arm. The supervisor refuses without passed pre-flight
-        checks and re-asks while the vehicle refuses (pre-arm checks still running)."""
-        st = self.station
-        st.set_sticks(1500, 1500, 1500, 1000)
-        st.set_mode(FlightMode.STABILIZE)
-        self.wait("STABILIZE mode", lambda s: s.vehicle_mode == FlightMode.STABILIZE, 10.0)
-        self.pause(self.plan.rest_s)
-        asked_at = st.clock.now_s()
-        st.request_arm()
-
-        def armed_or_refused(s: StationSnapshot) -> bool:
-            refused = [e for e in s.events if e.t_s >= asked_at
-                       and e.text.startswith(("arm refused", "disarmed: vehicle did not arm"))]
-            if refused:
-                raise FlightFailed(f"{refused[-1].text}{self._vehicle_said(s)}")
-            return s.armed and s.state is SupervisorState.MANUAL
-
-        self.wait("arming", armed_or_refused, self.plan.arm_timeout_s)
-
-    @staticmethod
-    def _vehicle_said(snap: StationSnapshot, recent_s: float = 5.0) -> str:
-        """The vehicle's last text if it is recent (an old one explains nothing)."""
-        texts = [e.text for e in snap.events if e.text.startswith("vehicle:")
-                 and snap.t_s - e.t_s <= recent_s]
-        return f" ({texts[-1]})" if texts else ""
+        """STABILIZE, throttle at minimum, rest, arm: the launch every flight shares
+        (`gcs.launch`); LaunchFailed, the vehicle disarmed, when it did not arm."""
+        self.launch.arm()
 
     def fly(self) -> None:
         """Take off, settle, hold, step (if asked), land and disarm."""
@@ -259,17 +270,7 @@ class FlightRunner:
         if p.takeoff_delay_s > 0.0:
             self.pause(p.takeoff_delay_s)
         self._target = p.alt_m
-        asked_at = st.clock.now_s()
-        st.alt_hold(True, p.alt_m, rate_mps=p.climb_mps)
-
-        def taking_off(s: StationSnapshot) -> bool:
-            refused = [e for e in s.events if e.t_s >= asked_at
-                       and e.text.startswith("altitude hold refused")]
-            if refused:
-                raise FlightFailed(refused[-1].text)
-            return s.state is not SupervisorState.MANUAL
-
-        self.wait("take-off request", taking_off, 2.0)
+        self.launch.ask_takeoff(p.alt_m, p.climb_mps)
         self.phase = Phase.TAKEOFF
         pose = st.snapshot(loop_stats=False).mocap
         if pose is not None:

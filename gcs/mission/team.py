@@ -1,28 +1,24 @@
 """The vehicles of one mission flown as a team: armed together, off together, landed, watched.
 
-Arming is the dangerous wait. A firmware disarms a vehicle that stands armed on the floor with
-the throttle at minimum (ArduCopter 3.2.1 after 15 s, 4.x after DISARM_DELAY), so arming one
-vehicle after another and taking off once the last is ready loses the first. Here every vehicle
-is put in STABILIZE and left to rest together, asked to arm in one go, and the take-off follows
-the moment the last one is armed; should that take longer than the shortest auto-disarm allows,
-every vehicle is disarmed and the mission fails before anything leaves the floor.
+Arming together and asking for the take-off are `gcs.launch`'s, the same as `fly`'s: the
+take-off follows the moment the last vehicle is armed, or every vehicle is disarmed and the
+mission fails before anything leaves the floor.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable
 
 from firmware_link.records import FlightMode
 from gcs.errors import RuntimeFault
+from gcs.launch import Launch, LaunchStage
 from gcs.mission.craft import Craft, CraftPhase, go_to_all
 from gcs.mission.events import EventLog, MissionEvent
 from gcs.mission.off_mission import off_mission
 from gcs.mission.recording import MissionRecording
 from gcs.mission.spec import MissionSpec
 from gcs.station.station import StationSnapshot
-from gcs.supervisor import SupervisorState
 from planners.geometry import Vec3
 
 POSITION_HOLD_FROM_M = 0.3  # take-off: hold position only once clear of the floor's friction
@@ -31,12 +27,9 @@ DESCENT_MPS = 0.3
 HANDOVER_ALT_M = 0.15  # below this (estimate), LAND mode finishes the touch-down
 STILL_MPS = 0.05  # sinking slower than this (mocap) for STILL_S: standing on something
 STILL_S = 1.0
-REST_S = 3.0  # disarmed on the floor first: the estimators learn the accelerometer bias at rest
-MODE_TIMEOUT_S = 10.0
-# Take-off must be asked this long before the first-armed vehicle's auto-disarm: the request
-# reaches the vehicle on the next tick, and the throttle has to leave minimum there.
-AUTO_DISARM_MARGIN_S = 5.0
 POLL_S = 0.1
+STAGE_EVENTS = {LaunchStage.ARMING: MissionEvent.ARMING, LaunchStage.ARMED: MissionEvent.ARMED,
+                LaunchStage.DISARMED: MissionEvent.DISARMED_ON_FLOOR}
 
 
 class Team:
@@ -55,6 +48,7 @@ class Team:
         self.min_separation_m = math.inf
         self.armed_at_s: dict[int, float] = {}
         self.gone: dict[int, str] = {}  # vehicles the station no longer flies, and why
+        self.launch = Launch({v: c.station for v, c in crafts.items()}, _TeamPort(self))
 
     def event(self, what: MissionEvent, vehicle: int | None = None, detail: str = "") -> None:
         """Tell the pilot and the recording."""
@@ -81,77 +75,15 @@ class Team:
         for a, b in itertools.combinations(pts, 2):
             self.min_separation_m = min(self.min_separation_m, math.dist(a, b))
 
-    def _pause(self) -> None:
+    def pause(self) -> None:
         """Between looks at the stations: rarely, every look takes the GIL from the loops."""
         self.clock.sleep_until(self.clock.now_s() + POLL_S)
 
-    def auto_disarm_s(self) -> float:
-        """The shortest auto-disarm delay of the team's firmwares."""
-        return min(c.station.supervisor_params.auto_disarm_s for c in self.crafts.values())
-
     # ------------------------------------------------------------------ arming
-    def _wait_all(self, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> list[int]:
-        """Poll until `pred` holds for every vehicle; the vehicles it did not, on timeout."""
-        deadline = self.clock.now_s() + timeout_s
-        while True:
-            late = [v for v, c in self.crafts.items() if not pred(c.snapshot())]
-            if not late or self.clock.now_s() >= deadline:
-                return late
-            self._pause()
-
     def arm(self) -> None:
-        """STABILIZE, rest, then arm every vehicle at once (see the module's docstring)."""
-        for c in self.crafts.values():
-            c.station.set_sticks(1500, 1500, 1500, 1000)
-            c.station.set_mode(FlightMode.STABILIZE)
-
-        def in_stabilize(s: StationSnapshot) -> bool:
-            return s.vehicle_mode == FlightMode.STABILIZE
-
-        late = self._wait_all(in_stabilize, MODE_TIMEOUT_S)
-        if late:
-            raise RuntimeFault(f"arming: vehicles {late} did not switch to STABILIZE within "
-                               f"{MODE_TIMEOUT_S:g} s")
-        self.clock.sleep_until(self.clock.now_s() + REST_S)
-        asked_at = self.clock.now_s()
-        self.event(MissionEvent.ARMING, detail=f"{len(self.crafts)} vehicle(s) together")
-        for c in self.crafts.values():
-            c.station.request_arm()
-        budget_s = self.auto_disarm_s() - AUTO_DISARM_MARGIN_S
-        deadline = asked_at + budget_s
-        refused: dict[int, str] = {}
-        while True:
-            now = self.clock.now_s()
-            for v, c in self.crafts.items():
-                snap = c.snapshot()
-                if snap.armed and snap.state is SupervisorState.MANUAL:
-                    self.armed_at_s.setdefault(v, now)
-                words = [e.text for e in snap.events if e.t_s >= asked_at and e.text.startswith(
-                    ("arm refused", "disarmed: vehicle did not arm"))]
-                if words:
-                    refused[v] = words[-1]
-            ready = len(self.armed_at_s) == len(self.crafts)
-            first = min(self.armed_at_s.values(), default=now)
-            if ready and now - first <= budget_s:
-                self.event(MissionEvent.ARMED,
-                           detail=f"all within {now - first:.1f} s of the first")
-                return
-            if refused or now >= deadline or now - first > budget_s:
-                self.disarm_all()
-                late = sorted(set(self.crafts) - set(self.armed_at_s))
-                why = "; ".join(f"vehicle {v}: {t}" for v, t in sorted(refused.items()))
-                raise RuntimeFault(
-                    f"arming: vehicles {late} not armed within {budget_s:g} s of the request "
-                    f"(the firmware disarms on the floor after {self.auto_disarm_s():g} s); "
-                    f"every vehicle disarmed" + (f" ({why})" if why else ""))
-            self._pause()
-
-    def disarm_all(self) -> None:
-        """Disarm every vehicle on the floor (throttle minimum first)."""
-        for c in self.crafts.values():
-            c.station.set_sticks(1500, 1500, 1500, 1000)
-            c.station.request_disarm()
-        self.event(MissionEvent.DISARMED_ON_FLOOR)
+        """STABILIZE, rest, then arm every vehicle at once (`gcs.launch`); LaunchFailed, every
+        vehicle disarmed, when they did not arm together."""
+        self.armed_at_s = self.launch.arm()
 
     # ------------------------------------------------------------------ take-off
     def take_off(self) -> dict[int, Vec3]:
@@ -164,13 +96,15 @@ class Team:
             here = c.position_n()
             hover[v] = (here[0], here[1], -alt)
             c.phase = CraftPhase.TAKEOFF
-            c.station.alt_hold(True, alt, rate_mps=CLIMB_MPS)
         self.event(MissionEvent.TAKING_OFF, detail=f"to {alt:.2f} m")
+        self.launch.ask_takeoff(alt, CLIMB_MPS)
         deadline = self.clock.now_s() + alt / CLIMB_MPS + 20.0
         holding: set[int] = set()
         while True:
             for v, c in self.crafts.items():
-                est = c.snapshot().estimate
+                snap = c.snapshot()
+                self.launch.check_climb(snap, v)
+                est = snap.estimate
                 if v not in holding and est is not None and est.alt_m > POSITION_HOLD_FROM_M:
                     c.command(hover[v])
                     holding.add(v)
@@ -179,7 +113,7 @@ class Team:
             if self.clock.now_s() > deadline:
                 raise RuntimeFault(f"take-off: vehicles {sorted(set(self.crafts) - holding)} "
                                    f"did not leave the floor")
-            self._pause()
+            self.pause()
         settled = go_to_all(self.crafts, hover, self.spec.position_tolerance_m,
                             self.spec.settle_s, alt / CLIMB_MPS + 15.0, self.watch_separation)
         late = [v for v, ok in settled.items() if not ok]
@@ -265,7 +199,7 @@ class Team:
                     still_since = None
             if z is not None:
                 last = (now, z)
-            self._pause()
+            self.pause()
         st.set_sticks(1500, 1500, 1500, 1000)
         st.set_mode(FlightMode.LAND)  # PC hold stays on until a heartbeat shows LAND
         for _ in range(4):
@@ -273,3 +207,27 @@ class Team:
                 return
             st.request_disarm()
         raise RuntimeFault(f"vehicle {c.sysid} did not disarm after landing")
+
+
+class _TeamPort:
+    """How the launch looks and waits in a mission: each vehicle's craft, 10 Hz on the team's
+    clock, its stages recorded as mission events."""
+
+    def __init__(self, team: Team) -> None:
+        self.team = team
+
+    def now_s(self) -> float:
+        return self.team.clock.now_s()
+
+    def look(self, vehicle: int) -> StationSnapshot:
+        return self.team.crafts[vehicle].snapshot()
+
+    def idle(self) -> None:
+        self.team.pause()
+
+    def rest(self, seconds: float) -> None:
+        clock = self.team.clock
+        clock.sleep_until(clock.now_s() + seconds)
+
+    def told(self, stage: LaunchStage, detail: str) -> None:
+        self.team.event(STAGE_EVENTS[stage], detail=detail)

@@ -70,6 +70,7 @@ from gcs.supervisor import (
     Intent,
     IntentKind,
     LinkHealth,
+    Outcome,
     Supervisor,
     SupervisorOutput,
     SupervisorParams,
@@ -137,6 +138,7 @@ class Station(StationIntents):
         self._intents: queue.SimpleQueue[Intent] = queue.SimpleQueue()
         self._lock = threading.Lock()
         self._events: deque[StationEvent] = deque(maxlen=self.config.events_kept)
+        self._outcomes: deque[Outcome] = deque(maxlen=self.config.events_kept)
         self._latest: dict[type, TelemetryRecord] = {}
         self._thread: threading.Thread | None = None
         self._stepped = False  # run by run_tick() on the caller's thread (lockstep)
@@ -402,6 +404,7 @@ class Station(StationIntents):
             link.rc_override(out.command)
         for note in out.notes:
             self._event(t_s, EventLevel(int(note.level)), note.text)
+        self._outcomes.extend(out.outcomes)
 
     def _ingest(self, records: list[TelemetryRecord]) -> tuple[
             list[Imu], list[Rangefinder], Attitude | None, Barometer | None]:
@@ -494,4 +497,5 @@ class Station(StationIntents):
             link_down_s=self._link_down_s,
             safe_throttle_us=(sup.safe_throttle_us(self._estimate.alt_m)
                               if self._estimate is not None else STICK_MIN_US),
+            outcomes=tuple(self._outcomes),
         )

@@ -21,7 +21,7 @@ from gcs.control.altitude_controller import AltControlOutput
 from gcs.control.position_controller import PositionCommand, PositionSetpoint
 from gcs.estimation import AltEstimate
 from gcs.station.loop import LoopStats
-from gcs.supervisor import LinkHealth, SupervisorState
+from gcs.supervisor import LinkHealth, Outcome, SupervisorState
 
 NEVER_S = 1.0e9
 """Stand-in for 'never' in recorded times: finite, so a recording gives it back unchanged."""
@@ -89,6 +89,7 @@ class StationSnapshot:
     listener_errors: int = 0
     link_down_s: float = 0.0  # total time the link has been lost so far
     safe_throttle_us: int = 1000  # what a dead station leaves it on: hover aloft, minimum down
+    outcomes: tuple[Outcome, ...] = ()  # the supervisor's request outcomes, newest last
 
 
 @dataclass(frozen=True, slots=True)

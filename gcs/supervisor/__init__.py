@@ -1,5 +1,6 @@
 """The flight supervisor: one pure state machine that decides every tick what is safe."""
 
+from gcs.supervisor.outcomes import ARM_FAILED, Outcome, OutcomeKind
 from gcs.supervisor.params import SupervisorParams
 from gcs.supervisor.supervisor import Supervisor
 from gcs.supervisor.types import (
@@ -21,6 +22,7 @@ from gcs.supervisor.types import (
 
 __all__ = [
     "AIRBORNE_CAPABLE",
+    "ARM_FAILED",
     "PC_CONTROL",
     "Action",
     "ActionKind",
@@ -29,6 +31,8 @@ __all__ = [
     "Level",
     "LinkHealth",
     "Note",
+    "Outcome",
+    "OutcomeKind",
     "Supervisor",
     "SupervisorOutput",
     "SupervisorParams",

@@ -27,6 +27,7 @@ from gcs.control.altitude_controller import AltControlOutput, AltitudeController
 from gcs.control.position_controller import PositionCommand, PositionController, PositionSetpoint
 from gcs.estimation import SonarStatus
 from gcs.supervisor.envelope import blind_sink_limit
+from gcs.supervisor.outcomes import Outcome, OutcomeKind
 from gcs.supervisor.params import SupervisorParams
 from gcs.supervisor.types import (
     AIRBORNE_CAPABLE,
@@ -98,6 +99,7 @@ class Supervisor:
         self._actions: list[Action] = []
         self._notes: list[Note] = []
         self._transitions: list[Transition] = []
+        self._outcomes: list[Outcome] = []
         self._t = 0.0
 
     # ------------------------------------------------------------------ bookkeeping
@@ -115,6 +117,16 @@ class Supervisor:
 
     def _note(self, level: Level, text: str) -> None:
         self._notes.append(Note(level, text))
+
+    def _ended(self, kind: OutcomeKind, level: Level, text: str) -> None:
+        """A request's end: its note for the pilot, its outcome for the caller."""
+        self._note(level, text)
+        self._outcomes.append(Outcome(kind, self._t, text))
+
+    def _went(self, kind: OutcomeKind) -> None:
+        """A request's end told by the transition just made, with that transition's note."""
+        tr = self._transitions[-1]
+        self._outcomes.append(Outcome(kind, self._t, f"{tr.state.value}: {tr.reason}"))
 
     def _send_every(self, period_s: float, *actions: Action) -> None:
         if self._t >= self._next_send_s:
@@ -148,6 +160,7 @@ class Supervisor:
         """Decide this tick's command and messages."""
         self._t = inp.t_s
         self._actions, self._notes, self._transitions = [], [], []
+        self._outcomes = []
         for intent in inp.intents:
             self._apply(intent, inp)
         self._link = self.p.link_health(inp.vehicle.frame_age_s)
@@ -161,7 +174,7 @@ class Supervisor:
         return SupervisorOutput(
             state=self.state, link=self._link, command=command, heartbeat=heartbeat,
             actions=tuple(self._actions), notes=tuple(self._notes),
-            transitions=tuple(self._transitions),
+            transitions=tuple(self._transitions), outcomes=tuple(self._outcomes),
             alt_setpoint_m=self.alt_setpoint_m if self.state in PC_CONTROL else None,
             throttle_gate_us=self.gate_us if self.state is S.MANUAL else None,
             command_acc_mps2=None if command is None or self.state is not S.HOLD else
@@ -182,11 +195,11 @@ class Supervisor:
             self._note(Level.INFO if it.ok else Level.WARNING,
                        f"pre-flight {'passed' if it.ok else 'FAILED'}: {it.note}")
         elif self.state in (S.KILLED, S.RELEASED):
-            self._note(Level.WARNING, f"{k.value} ignored: station is {self.state.value}")
+            self._ignored(k, f"{k.value} ignored: station is {self.state.value}")
         elif k is IntentKind.QUIT:
             self._quit(inp)
         elif self.state in (S.LINK_LOST, S.SILENT, S.QUITTING):
-            self._note(Level.WARNING, f"{k.value} ignored while {self.state.value}")
+            self._ignored(k, f"{k.value} ignored while {self.state.value}")
         elif k is IntentKind.ARM:
             self._arm()
         elif k is IntentKind.DISARM:
@@ -210,11 +223,20 @@ class Supervisor:
         elif k is IntentKind.POSITION_OFF:
             self.pos_setpoint = None
 
+    def _ignored(self, kind: IntentKind, text: str) -> None:
+        if kind is IntentKind.ARM:
+            self._ended(OutcomeKind.ARM_IGNORED, Level.WARNING, text)
+        elif kind is IntentKind.ALT_HOLD:
+            self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING, text)
+        else:
+            self._note(Level.WARNING, text)
+
     def _arm(self) -> None:
         if self.state is not S.DISARMED:
-            self._note(Level.WARNING, f"arm ignored: already {self.state.value}")
+            self._ended(OutcomeKind.ARM_IGNORED, Level.WARNING,
+                        f"arm ignored: already {self.state.value}")
         elif not self.preflight_ok:
-            self._note(Level.ERROR, f"arm refused: {self.preflight_note}")
+            self._ended(OutcomeKind.ARM_REFUSED, Level.ERROR, f"arm refused: {self.preflight_note}")
         else:
             self._go(S.ARMING, "arm requested")
 
@@ -227,16 +249,18 @@ class Supervisor:
                 self._takeoff_wanted = True
                 self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
                 return
-            self._note(Level.WARNING, f"altitude hold refused: {why}")
+            self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING,
+                        f"altitude hold refused: {why}")
             return
         if inp.vehicle.seen and not inp.vehicle.armed:
             # The heartbeat saying so may come before the tick that leaves MANUAL for DISARMED
             # (intents are applied first): a take-off ramp on a disarmed vehicle winds up.
-            self._note(Level.WARNING, "altitude hold refused: the vehicle is disarmed")
+            self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING,
+                        "altitude hold refused: the vehicle is disarmed")
             return
         if inp.vehicle.mode != FlightMode.STABILIZE:
-            self._note(Level.WARNING, "altitude hold refused: the PC flies in STABILIZE, the "
-                       f"vehicle is in {mode_name(inp.vehicle.mode)}")
+            self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING, "altitude hold refused: the "
+                        f"PC flies in STABILIZE, the vehicle is in {mode_name(inp.vehicle.mode)}")
             return
         self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
         if self.state is S.MANUAL:
@@ -300,6 +324,7 @@ class Supervisor:
                 self._go(S.SPOOL_UP, "armed: waiting for the motors to spool up")
             else:
                 self._to_manual("armed", STICK_MIN_US)
+            self._went(OutcomeKind.ARMED)
         elif st is S.QUITTING:
             if v.mode == FlightMode.LAND:
                 self._release("vehicle in LAND: overrides released")
@@ -346,6 +371,7 @@ class Supervisor:
             if self._t - self.since_s > self.p.arm_timeout_s:
                 self._go(S.DISARMED, f"vehicle did not arm within {self.p.arm_timeout_s:g} s",
                          Level.ERROR)
+                self._went(OutcomeKind.ARM_TIMED_OUT)
             else:
                 self._send_every(self.p.arm_resend_s, Action(ActionKind.ARM))
             return LEVEL, True
@@ -421,6 +447,7 @@ class Supervisor:
             back = p.ramp_rate_us_per_s * p.liftoff_lag_s
             self._engage(inp, max(STICK_MIN_US, min(hover, self._ramp_us - back)),
                          f"left the floor at {round(self._ramp_us)} us: altitude hold on")
+            self._went(OutcomeKind.LIFTED_OFF)
             return self._hold(inp)
         top = min(STICK_MAX_US, hover + p.ramp_above_hover_us)
         self._ramp_us = min(top, self._ramp_us + p.ramp_rate_us_per_s * inp.dt_s)
@@ -429,6 +456,7 @@ class Supervisor:
             if self._t - self._ramp_top_since_s > p.takeoff_give_up_s:
                 self._to_manual(f"take-off: the vehicle did not leave the floor at "
                                 f"{top} us", STICK_MIN_US, Level.ERROR)
+                self._went(OutcomeKind.TAKEOFF_FAILED)
                 return LEVEL
         return RcCommand(STICK_MID_US, STICK_MID_US, round(self._ramp_us), STICK_MID_US)
 

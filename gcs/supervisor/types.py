@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from firmware_link.records import FlightMode, MocapPose, RcCommand
 from gcs.estimation import AltEstimate
+from gcs.supervisor.outcomes import Outcome
 
 STICK_MIN_US, STICK_MID_US, STICK_MAX_US = 1000, 1500, 2000
 
@@ -172,6 +173,8 @@ class SupervisorOutput:
     # HOLD: the vertical acceleration the command's throttle asks of the vehicle (the hold's
     # filter predicts with it); None when the station does not fly the throttle
     command_acc_mps2: float | None = None
+    # how this tick ended requests (arm, take-off): what callers branch on, beside the notes
+    outcomes: tuple[Outcome, ...] = ()
 
 
 def mode_name(mode: int) -> str:

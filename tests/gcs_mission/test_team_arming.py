@@ -11,12 +11,12 @@ import pytest
 
 from firmware_link.records import FlightMode
 from gcs.clock import SimClock
-from gcs.errors import RuntimeFault
+from gcs.launch import AUTO_DISARM_MARGIN_S, LaunchFailed
 from gcs.mission.events import EventLog, MissionEvent
 from gcs.mission.spec import load_mission
-from gcs.mission.team import AUTO_DISARM_MARGIN_S, Team
+from gcs.mission.team import Team
 from gcs.station.types import StationEvent
-from gcs.supervisor import SupervisorParams, SupervisorState
+from gcs.supervisor import Outcome, SupervisorParams, SupervisorState
 
 MISSION = Path(__file__).resolve().parents[2] / "missions" / "flock_table.toml"
 
@@ -69,7 +69,7 @@ class FakeCraft:
         armed = st.armed()
         return _Snap(st.mode, armed, SupervisorState.MANUAL if armed else
                      SupervisorState.ARMING if st.asked_s is not None else
-                     SupervisorState.DISARMED, ())
+                     SupervisorState.DISARMED, (), 0.0, ())
 
 
 @dataclass(frozen=True)
@@ -78,6 +78,8 @@ class _Snap:
     armed: bool
     state: SupervisorState
     events: tuple[StationEvent, ...]
+    t_s: float
+    outcomes: tuple[Outcome, ...]
 
 
 def team(arm_after_s: list[float | None]) -> tuple[Team, list[FakeStation], list[Any]]:
@@ -102,7 +104,7 @@ def test_five_vehicles_are_asked_to_arm_in_one_go_after_resting_together() -> No
 
 def test_a_vehicle_that_never_arms_disarms_the_team_before_any_auto_disarm() -> None:
     t, stations, seen = team([0.5, None, 0.5, 0.5, 0.5])
-    with pytest.raises(RuntimeFault, match=r"vehicles \[2\] not armed within 10 s"):
+    with pytest.raises(LaunchFailed, match=r"vehicles \[2\] not armed within 10 s"):
         t.arm()
     assert all(s.disarm_asked for s in stations)
     first = min(s.armed_s for s in stations if s.armed_s is not None)
@@ -114,7 +116,7 @@ def test_a_vehicle_that_never_arms_disarms_the_team_before_any_auto_disarm() -> 
 def test_the_shortest_auto_disarm_of_the_team_sets_the_budget() -> None:
     t, stations, _ = team([0.5, 0.5, 6.0])
     stations[1].supervisor_params = SupervisorParams(auto_disarm_s=10.0)  # a 4.x vehicle
-    with pytest.raises(RuntimeFault, match="within 5 s"):
+    with pytest.raises(LaunchFailed, match="within 5 s"):
         t.arm()
     assert all(s.disarm_asked for s in stations)
 
