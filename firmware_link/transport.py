@@ -205,11 +205,6 @@ class UdpTransport(_Descriptor):
         sock.setblocking(False)
         return cls(spec, sock, peer)
 
-    @property
-    def local_port(self) -> int:
-        """The bound port (useful with udpin:...:0)."""
-        return int(self._sock.getsockname()[1])
-
     def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes:
         """Datagrams waiting (whole ones, about `max_bytes`), concatenated."""
         chunks: list[bytes] = []

@@ -19,7 +19,7 @@ from mcap.writer import CompressionType, Writer
 
 from logs.encoding import encode_json
 from logs.errors import RecordingError
-from logs.foxglove import WELL_KNOWN_SCHEMAS, time_dict
+from logs.foxglove import time_dict
 
 PROFILE = ""
 LIBRARY = "quadgcs-logs"
@@ -138,10 +138,6 @@ class McapSink:
         self._channels[topic] = channel_id
         self._sequence[channel_id] = 0
         return channel_id
-
-    def add_well_known_topic(self, topic: str, schema_name: str) -> int:
-        """Register `topic` with one of Foxglove's well-known schemas."""
-        return self.add_topic(topic, schema_name, WELL_KNOWN_SCHEMAS[schema_name])
 
     def write(
         self, topic: str, log_time_ns: int, message: Mapping[str, Any], *, stamp: bool = False

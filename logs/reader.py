@@ -168,11 +168,6 @@ class Recording:
         return decode_metadata(self._metadata_records)
 
     @property
-    def metadata_records(self) -> list[tuple[str, dict[str, str]]]:
-        """Every MCAP Metadata record as written: (name, string → string)."""
-        return list(self._metadata_records)
-
-    @property
     def start_ns(self) -> int:
         """Log time of the first message, ns (UTC)."""
         return self._start_ns

@@ -50,15 +50,6 @@ class Box:
         object.__setattr__(self, "min_n", lo)
         object.__setattr__(self, "max_n", hi)
 
-    @property
-    def size_m(self) -> Vec3:
-        """Edge lengths along north, east, down (m)."""
-        return (
-            self.max_n[0] - self.min_n[0],
-            self.max_n[1] - self.min_n[1],
-            self.max_n[2] - self.min_n[2],
-        )
-
     def contains(self, p: Vec3, margin_m: float = 0.0) -> bool:
         """True when `p` is inside the box grown by `margin_m` on every face."""
         return all(
@@ -172,13 +163,6 @@ class World:
     def in_room(self, p: Vec3, margin_m: float = 0.0) -> bool:
         """True when `p` is inside the room at least `margin_m` from every wall."""
         return self.room.inner_clearance(p) >= margin_m
-
-    def in_obstacle(self, p: Vec3) -> Box | None:
-        """The first obstacle containing `p`, or None."""
-        for box in self.obstacles:
-            if box.contains(p):
-                return box
-        return None
 
     def clearance(self, p: Vec3) -> float:
         """Distance from `p` to the nearest obstacle surface or room wall (0 when inside one)."""

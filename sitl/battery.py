@@ -64,11 +64,6 @@ def terminal_voltage_v(p: VehicleParams, used_mah: float, current_a: float) -> f
     return max(ocv - current_a * p.battery_resistance_ohm, 0.0)
 
 
-def drain_mah(current_a: float, dt_s: float) -> float:
-    """Charge drawn over dt_s at current_a, in mAh."""
-    return current_a * dt_s / 3.6
-
-
 def battery_state(p: VehicleParams, used_mah: float, current_a: float) -> BatteryState:
     """Report for the given charge used and present current."""
     return BatteryState(

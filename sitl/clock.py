@@ -31,8 +31,3 @@ class PacedClock:
         """Forget a backlog: treat `sim_t_s` as due now (after a long stall)."""
         self._wall0 = self._monotonic()
         self._sim0 = sim_t_s
-
-    def real_time_factor(self, sim_t_s: float) -> float:
-        """Simulated seconds per wall second since the last resync."""
-        wall = self._monotonic() - self._wall0
-        return (sim_t_s - self._sim0) / wall if wall > 0 else 0.0

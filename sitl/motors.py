@@ -20,13 +20,8 @@ def clamp_throttle(u: float) -> float:
     return 1.0 if u > 1.0 else u
 
 
-def thrust_fraction(u: float, expo: float) -> float:
-    """Steady thrust / max thrust at throttle u."""
-    return (1.0 - expo) * u + expo * u * u
-
-
 def throttle_for_fraction(fraction: float, expo: float) -> float:
-    """Inverse of thrust_fraction (clamped to 0..1)."""
+    """The throttle whose steady thrust fraction (1 - e)·u + e·u² is `fraction` (0..1)."""
     if fraction <= 0.0:
         return 0.0
     if expo <= 1e-9:
@@ -41,28 +36,6 @@ def max_speed_radps(p: VehicleParams, voltage_v: float) -> float:
     return derived(p).omega_max_ref_radps * max(voltage_v, 0.0) / p.ref_voltage_v
 
 
-def steady_speed_radps(p: VehicleParams, u: float, voltage_v: float) -> float:
-    """Rotor speed the motor settles at for throttle u."""
-    return max_speed_radps(p, voltage_v) * math.sqrt(
-        thrust_fraction(clamp_throttle(u), p.thrust_expo)
-    )
-
-
-def lag_alpha(p: VehicleParams, dt_s: float) -> float:
-    """Exact discrete gain of the first-order lag over dt_s (stable for any dt)."""
-    return 1.0 - math.exp(-dt_s / p.motor_lag_s)
-
-
 def thrust_n(p: VehicleParams, omega_radps: float) -> float:
     """Rotor thrust T = k_t·ω²."""
     return derived(p).k_thrust * omega_radps * omega_radps
-
-
-def reaction_torque_nm(p: VehicleParams, omega_radps: float) -> float:
-    """Magnitude of the rotor's aerodynamic drag torque Q = k_m·ω² (reacts on the body)."""
-    return derived(p).k_torque * omega_radps * omega_radps
-
-
-def shaft_power_w(p: VehicleParams, omega_radps: float) -> float:
-    """Mechanical power into the air: Q·ω = k_m·ω³."""
-    return derived(p).k_torque * omega_radps**3

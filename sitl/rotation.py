@@ -76,8 +76,3 @@ def rotate_n_to_b(q: Quat, v: Vec3) -> Vec3:
     """v_b = R(q_nb)ᵀ v_n."""
     w, x, y, z = q
     return rotate_b_to_n((w, -x, -y, -z), v)
-
-
-def yaw_only(q: Quat) -> Quat:
-    """The level attitude with the same heading as q."""
-    return quat_from_euler(0.0, 0.0, quat_to_euler(q)[2])

@@ -27,11 +27,11 @@ class StationIntents:
     def _intent(self, intent: Intent) -> None:
         self._intents.put(intent)
 
-    def request_arm(self, force: bool = False) -> None:
+    def request_arm(self) -> None:
         """Ask the vehicle to arm (refused by the supervisor until pre-flight checks pass)."""
         self._intent(Intent(IntentKind.ARM))
 
-    def request_disarm(self, force: bool = False) -> None:
+    def request_disarm(self) -> None:
         """Ask the vehicle to disarm."""
         self._intent(Intent(IntentKind.DISARM))
 

@@ -229,10 +229,6 @@ class Epbha:
         there = self._memory.segment_clearance(next_pos, next_pos, z)
         return there >= min(body, here + self.params.step_m / 2.0)
 
-    def _active(self, reading: ProximityReading, move: Move) -> bool:
-        seen = reading.along_n(move.vec())
-        return seen is not None and seen <= self.params.sensor_range_m
-
     def _lid_seen(self, pos_n: Vec3, reading: ProximityReading, over: Move) -> bool:
         """An obstacle overhead that is not the ceiling above the maximum altitude."""
         seen = reading.along_n(over.vec())
@@ -486,4 +482,3 @@ class Epbha:
     ) -> Decision:
         return Decision(pos, Status.DEADLOCK, reason, obstacle, self.plane, self.heading, table,
                         0, options)
-

@@ -86,11 +86,6 @@ def role_of(index: int, n_vehicles: int) -> Role:
     return Role.RELAY if children_of(index, n_vehicles) else Role.FOLLOWER
 
 
-def depth_of(index: int) -> int:
-    """Tree depth of vehicle ``index`` (root 0)."""
-    return math.floor(math.log2(index + 1))
-
-
 def _lattice_xy(i: int, j: int) -> tuple[float, float]:
     """Formation-frame position of lattice point (i, j) for unit side."""
     c30 = math.cos(math.radians(30.0))

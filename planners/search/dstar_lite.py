@@ -70,9 +70,6 @@ class DStarLite:
         m = min(self.g.get(u, INF), self.rhs.get(u, INF))
         return (m + self._h(self.start, u) + self.km, m)
 
-    def _cost(self, u: int, d: int) -> float:
-        return self.res if self.known[d][u] else INF
-
     def _best_rhs(self, u: int) -> float:
         best = INF
         for d, off in enumerate(self.steps):

@@ -176,10 +176,6 @@ class StreamSchedule:
         # and `due` then returns at once instead of looking at every message
         self._earliest_s = -math.inf
 
-    def streamable(self, name: str) -> bool:
-        """Whether `name` is a message this link can stream."""
-        return name in self._msgs
-
     def request_stream(self, stream_id: int, rate_hz: float, start: bool) -> None:
         """REQUEST_DATA_STREAM: set one group's (or all groups') rate parameter."""
         rate = min(MAX_RATE_HZ, max(0.0, float(rate_hz))) if start else 0.0
