@@ -19,10 +19,10 @@ import numpy as np
 
 from firmware_link.truth_link import TruthLink
 from gcs.config import StationConfig, load_config
+from gcs.core.landing import may_leave, must_land
 from gcs.errors import UsageError
 from gcs.lockstep import BundledLockstep, LockstepOptions, SteppedTruth, TeamClock
 from gcs.station.session import SCORED_COMMANDS, SessionOptions, StationSession
-from gcs.station.station import LAND_UNTIL, LAND_WAIT_STATES
 
 LOCKSTEP_EPOCH_NS = 946_684_800 * 10**9
 """2000-01-01T00:00:00Z: where simulated time zero sits on a lockstep recording's timeline. A
@@ -105,7 +105,7 @@ class LockstepSession(StationSession):
         vehicles waiting their turn would get no overrides for seconds."""
         flying = [v.station for v in self.vehicles.values()
                   if v.station.error is None
-                  and v.station.snapshot(loop_stats=False).state in LAND_UNTIL]
+                  and must_land(v.station.snapshot(loop_stats=False).state)]
         if len(flying) < 2:
             return
         clock = TeamClock(self.sitl.sitl, list(flying))
@@ -118,7 +118,7 @@ class LockstepSession(StationSession):
                 next_ask += 1.0
             clock.sleep_until(clock.now_s() + POLL_S)
             if all(st.error is not None
-                   or st.snapshot(loop_stats=False).state in LAND_WAIT_STATES for st in flying):
+                   or may_leave(st.snapshot(loop_stats=False).state) for st in flying):
                 return
 
     def tick(self) -> None:

@@ -2,11 +2,11 @@
 instances, and measure how their outputs differ from what the station computed in the air.
 
 The station records, per tick, which telemetry records and intents it consumed and what it knew
-of the vehicle (`/gcs/tick`, `TickInputs`, `/gcs/intent`), and once its configuration, throttle
-curve and supervisor policy (`/gcs/setup`). From these the rerun rebuilds every tick's inputs
-exactly as the station saw them — the same IMU samples averaged in the same order, the same sonar
-readings, the newest attitude and mocap pose, the same intents and heartbeat state — so with
-unchanged parameters every output is bit-identical to the recording. With changed parameters
+of the vehicle (`/gcs/tick`, a `TickRecord`; the records on their own topics, `/gcs/intent`), and
+once its configuration, throttle curve and supervisor policy (`/gcs/setup`). From these the rerun
+rebuilds every tick's `TickInputs` exactly as the station's flight core got them and steps a
+fresh `FlightCore` on them, so with unchanged parameters every output is bit-identical to the
+recording. With changed parameters
 (`apply_overrides`) it shows what those gains would have done with the same sensor data.
 
 Not replayed: the vehicle's response. The sensor data are those of the flight as flown, so a
@@ -29,13 +29,13 @@ from typing import Any
 from firmware_link.records import Attitude, Barometer, Imu, MocapPose, Rangefinder
 from gcs import params_json, topics
 from gcs.config import StationConfig, _build
-from gcs.control.altitude_controller import AltControlOutput, AltitudeController
-from gcs.control.position_controller import PositionController
+from gcs.control.altitude_controller import AltControlOutput
 from gcs.control.throttle_curve import ThrottleCurve
+from gcs.core import FlightCore, TickInputs, TickRecord
 from gcs.errors import UsageError
-from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
-from gcs.station.station import StationSetup, TickInputs
-from gcs.supervisor import Intent, Supervisor, SupervisorParams, TickIn, VehicleStatus
+from gcs.estimation import AltEstimate
+from gcs.station.types import StationSetup
+from gcs.supervisor import Intent, SupervisorParams
 from gcs.toml_file import read_toml
 from logs import Recording, RecordingError, from_jsonable
 
@@ -48,20 +48,6 @@ GAIN_ALIASES: dict[str, str] = {
 
 
 @dataclass(frozen=True, slots=True)
-class TickFrame:
-    """One recorded tick with the telemetry records it consumed."""
-
-    log_ns: int
-    inputs: TickInputs
-    imus: tuple[Imu, ...]
-    sonars: tuple[Rangefinder, ...]
-    attitudes: tuple[Attitude, ...]
-    baros: tuple[Barometer, ...] = ()
-    mocaps: tuple[MocapPose, ...] = ()
-    intents: tuple[Intent, ...] = ()
-
-
-@dataclass(frozen=True, slots=True)
 class RecordedFlight:
     """What a rerun reads from a recording: setup, ticks and the station's recorded outputs."""
 
@@ -69,7 +55,8 @@ class RecordedFlight:
     curve: ThrottleCurve
     hover_throttle: float
     supervisor: SupervisorParams
-    ticks: tuple[TickFrame, ...]
+    ticks: tuple[TickInputs, ...]
+    tick_ns: tuple[int, ...]  # each tick's log time (ns), the key of the outputs below
     estimates: Mapping[int, AltEstimate]  # by log time (ns) of the tick
     alt_outputs: Mapping[int, AltControlOutput]
 
@@ -184,59 +171,36 @@ def load_flight(recording: Recording) -> RecordedFlight:
                              f"ran out of them (truncated, or the recorder dropped messages)")
         return got
 
-    frames = []
-    for log_ns, msg in by_topic[topics.TICK]:
-        t = _decode(TickInputs, msg, f"{name} {topics.TICK}")
-        frames.append(TickFrame(log_ns, t, take(imus, t.imu_n, topics.IMU, t.tick),
-                                take(sonars, t.rangefinder_n, topics.RANGEFINDER, t.tick),
-                                take(atts, t.attitude_n, topics.ATTITUDE, t.tick),
-                                take(baros, t.baro_n, topics.BAROMETER, t.tick),
-                                take(mocaps, t.mocap_n, topics.MOCAP_POSE, t.tick),
-                                take(intents, t.intent_n, topics.INTENT, t.tick)))
+    ticks: list[TickInputs] = []
+    for _ns, msg in by_topic[topics.TICK]:
+        t = _decode(TickRecord, msg, f"{name} {topics.TICK}")
+        ticks.append(t.inputs(take(imus, t.imu_n, topics.IMU, t.tick),
+                              take(sonars, t.rangefinder_n, topics.RANGEFINDER, t.tick),
+                              take(atts, t.attitude_n, topics.ATTITUDE, t.tick),
+                              take(baros, t.baro_n, topics.BAROMETER, t.tick),
+                              take(mocaps, t.mocap_n, topics.MOCAP_POSE, t.tick),
+                              take(intents, t.intent_n, topics.INTENT, t.tick)))
     estimates = {ns: _decode(AltEstimate, m, f"{name} {topics.ESTIMATE}")
                  for ns, m in by_topic[topics.ESTIMATE]}
     alts = {ns: _decode(AltControlOutput, m, f"{name} {topics.ALT_CONTROLLER}")
             for ns, m in by_topic.get(topics.ALT_CONTROLLER, [])}
-    return RecordedFlight(config, curve, setup.hover_throttle, supervisor, tuple(frames),
-                          estimates, alts)
+    return RecordedFlight(config, curve, setup.hover_throttle, supervisor, tuple(ticks),
+                          tuple(ns for ns, _ in by_topic[topics.TICK]), estimates, alts)
 
 
 # ------------------------------------------------------------------ the rerun (pure)
 def rerun(flight: RecordedFlight, config: StationConfig | None = None) -> RerunOutputs:
-    """Run a fresh estimator and a fresh supervisor (with its controllers) over the recorded
-    ticks, exactly as `Station._tick` drives them (`config`: the recorded one if None)."""
+    """Step a fresh flight core on the recorded ticks' inputs, as the station stepped its own
+    (`config`: the recorded one if None)."""
     cfg = flight.config if config is None else config
-    estimator = make_estimator(cfg.estimator_kind.value, cfg.estimator)
-    ctrl = AltitudeController(cfg.altitude, flight.curve, flight.hover_throttle)
-    sup = Supervisor(flight.supervisor, ctrl, PositionController(cfg.position),
-                     rest_alt_m=cfg.estimator.rest_alt_m, ground_alt_m=cfg.estimator.ground_alt_m)
+    core = FlightCore(cfg, flight.curve, flight.hover_throttle, flight.supervisor)
     estimates: dict[int, AltEstimate] = {}
     alts: dict[int, AltControlOutput] = {}
-    latest_att: Attitude | None = None
-    latest_pose: MocapPose | None = None
-    cmd_acc: float | None = None  # what the previous tick's command asked of the vehicle
-    for frame in flight.ticks:
-        t = frame.inputs
-        if frame.attitudes:
-            latest_att = frame.attitudes[-1]
-        if frame.mocaps:
-            latest_pose = frame.mocaps[-1]
-        attitude = frame.attitudes[-1] if frame.attitudes else None
-        sonars = frame.sonars
-        baro = baro_altitude_m(frame.baros[-1].pressure_pa) if frame.baros else None
-        est = estimator.update_tick(list(frame.imus), sonars, attitude, t.t_s,
-                                    at_rest=t.at_rest, baro_alt_m=baro, command_acc_mps2=cmd_acc)
-        estimates[frame.log_ns] = est
-        cmd_acc = sup.step(TickIn(
-            t_s=t.t_s, dt_s=t.dt_s, intents=frame.intents,
-            vehicle=VehicleStatus(seen=t.vehicle_seen, armed=t.armed, mode=t.vehicle_mode,
-                                  heartbeat_t_s=t.heartbeat_t_s, frame_age_s=t.frame_age_s),
-            estimate=est,
-            roll_rad=latest_att.roll_rad if latest_att is not None else 0.0,
-            pitch_rad=latest_att.pitch_rad if latest_att is not None else 0.0,
-            mocap=latest_pose)).command_acc_mps2
-        if sup.alt is not None:  # the station records the last output on held ticks too
-            alts[frame.log_ns] = sup.alt
+    for log_ns, inputs in zip(flight.tick_ns, flight.ticks, strict=True):
+        out = core.step(inputs)
+        estimates[log_ns] = out.estimate
+        if out.alt is not None:  # the station records the last output on held ticks too
+            alts[log_ns] = out.alt
     return RerunOutputs(estimates, alts)
 
 

@@ -8,13 +8,9 @@ from typing import Any
 
 from firmware_link.records import FlightMode, Heartbeat, RcCommand
 from gcs.supervisor import SupervisorState
-from gcs.supervisor.types import AIRBORNE_CAPABLE
 
 EMERGENCY_LAND_S = 3.0
 MODE_RESEND_S = 0.5
-LAND_ON_DEATH = AIRBORNE_CAPABLE | {SupervisorState.LINK_LOST}
-"""States in which a station that dies (its loop, or its whole process: `gcs.station.guardian`) has
-the vehicle asked for LAND: it may be armed and in the air, and the station was flying it."""
 
 
 def let_go(link: Any, state: SupervisorState, hb: Heartbeat | None) -> str:

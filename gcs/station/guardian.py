@@ -36,7 +36,8 @@ from typing import Any
 
 from firmware_link.connection import Transport
 from firmware_link.records import Heartbeat
-from gcs.station.exit import LAND_ON_DEATH, emergency_land, let_go
+from gcs.core.landing import lands_on_death
+from gcs.station.exit import emergency_land, let_go
 from gcs.station.types import StationSnapshot
 from gcs.supervisor import SupervisorState
 
@@ -109,7 +110,7 @@ class Guardian:
         if self._gone:
             return
         self._send_handoff()
-        state = (snap.state in LAND_ON_DEATH, snap.safe_throttle_us, snap.state.value)
+        state = (lands_on_death(snap.state), snap.safe_throttle_us, snap.state.value)
         last = self._sent_state
         changed = (last is None or state[0] != last[0] or state[2] != last[2]
                    or abs(state[1] - last[1]) >= THROTTLE_STEP_US)

@@ -1,11 +1,12 @@
-"""The station: one vehicle link, the estimator and the supervisor, on a 25 ms loop thread.
+"""The station: one vehicle link and the flight core, on a 25 ms loop thread.
 
-Each tick: poll the link (and motion capture) → altitude estimate → `Supervisor.step` with the
-pilot's intents and what the vehicle said → the messages it decided (arm, disarm, modes) and the
-RC_CHANNELS_OVERRIDE it allows (every tick unless it chose silence) → recorder.
+Each tick: poll the link (and motion capture) → `FlightCore.step` with the records, the pilot's
+intents and what the vehicle said (estimate, supervisor, controllers) → the messages it decided
+(arm, disarm, modes) and the RC_CHANNELS_OVERRIDE it allows (every tick unless it chose
+silence) → recorder.
 
-The station itself decides nothing about safety: it is I/O and scheduling around the pure
-supervisor (gcs.supervisor), whose inputs it records so `replay --rerun` runs the same code.
+The station itself decides nothing about safety: it is I/O and scheduling around the pure flight
+core (gcs.core), whose inputs it records so `replay --rerun` runs the same code on them.
 Other threads talk to it only through intents (`request_arm()`, `alt_hold()`, `kill()`, ...),
 queued and applied at the next tick, and read it through `snapshot()`.
 
@@ -27,7 +28,6 @@ from typing import Any
 from firmware_link.errors import LinkUsageError
 from firmware_link.records import (
     Attitude,
-    Barometer,
     CommandAck,
     Dialect,
     Heartbeat,
@@ -43,16 +43,16 @@ from firmware_link.records import (
 from gcs import params_json, topics
 from gcs.clock import Clock, MonotonicClock
 from gcs.config import StationConfig
-from gcs.control.altitude_controller import AltitudeController
-from gcs.control.position_controller import PositionController
 from gcs.control.throttle_curve import ThrottleCurve
-from gcs.estimation import AltEstimate, baro_altitude_m, make_estimator
-from gcs.station.exit import LAND_ON_DEATH, emergency_land, let_go
+from gcs.core import FlightCore, TickInputs
+from gcs.core.inputs import NEVER_S
+from gcs.core.landing import may_leave, must_land
+from gcs.estimation import AltEstimator
+from gcs.station.exit import emergency_land, let_go
 from gcs.station.intents import STICK_MAX_US, STICK_MIN_US, StationIntents
 from gcs.station.loop import FixedRateLoop
-from gcs.station.record import TickRecord, record_tick
+from gcs.station.record import record_tick
 from gcs.station.types import (
-    NEVER_S,
     ControlMode,
     EventLevel,
     LinkLike,
@@ -61,11 +61,9 @@ from gcs.station.types import (
     StationEvent,
     StationSetup,
     StationSnapshot,
-    TickInputs,
     control_mode,
 )
 from gcs.supervisor import (
-    AIRBORNE_CAPABLE,
     ActionKind,
     Intent,
     IntentKind,
@@ -75,7 +73,6 @@ from gcs.supervisor import (
     SupervisorOutput,
     SupervisorParams,
     SupervisorState,
-    TickIn,
     VehicleStatus,
 )
 
@@ -89,18 +86,8 @@ __all__ = [
     "StationEvent",
     "StationSetup",
     "StationSnapshot",
-    "TickInputs",
     "control_mode",
 ]
-
-LAND_WAIT_STATES = frozenset({SupervisorState.RELEASED, SupervisorState.DISARMED,
-                              SupervisorState.SILENT})
-"""A stopping station may leave once the supervisor is in one of these (a lost link first gets
-its LAND requests, then the silence that lets the vehicle's failsafe act)."""
-
-
-LAND_UNTIL = AIRBORNE_CAPABLE | {SupervisorState.KILLED, SupervisorState.LINK_LOST}
-"""States in which a stopping station lands the vehicle before it lets go."""
 
 
 class Station(StationIntents):
@@ -127,12 +114,7 @@ class Station(StationIntents):
         dialect = getattr(link, "dialect", Dialect.UNKNOWN)
         self.supervisor_params = supervisor or SupervisorParams.for_dialect(
             dialect if isinstance(dialect, Dialect) else Dialect.UNKNOWN)
-        self.estimator = make_estimator(self.config.estimator_kind.value, self.config.estimator)
-        self.alt_ctrl = AltitudeController(self.config.altitude, self.curve, hover_throttle)
-        self.pos_ctrl = PositionController(self.config.position)
-        est = self.config.estimator
-        self.supervisor = Supervisor(self.supervisor_params, self.alt_ctrl, self.pos_ctrl,
-                                     rest_alt_m=est.rest_alt_m, ground_alt_m=est.ground_alt_m)
+        self.core = FlightCore(self.config, self.curve, hover_throttle, self.supervisor_params)
         self.loop = FixedRateLoop(self.clock, self.config.period_s, self._tick,
                                   realtime_priority=self.config.realtime_priority)
         self._intents: queue.SimpleQueue[Intent] = queue.SimpleQueue()
@@ -149,16 +131,20 @@ class Station(StationIntents):
         self._listener_errors = 0
         self._last_rx_s = -NEVER_S
         self._heartbeats_on = True
-        self._estimate: AltEstimate | None = None
-        self._out: SupervisorOutput | None = None
-        self._link_down_s = 0.0
-        self._out_link = LinkHealth.OK
         self._empty_stats = self.loop.stats()
         self._snapshot = self._make_snapshot(self.clock.now_s(), -1)
         if recorder is not None:
             recorder.put(topics.SETUP, self.clock.now_s(), StationSetup(
                 params_json.dumps(self.config), params_json.dumps(self.curve),
-                self.alt_ctrl.hover_throttle, params_json.dumps(self.supervisor_params)))
+                self.core.alt_ctrl.hover_throttle, params_json.dumps(self.supervisor_params)))
+
+    @property
+    def supervisor(self) -> Supervisor:
+        return self.core.supervisor
+
+    @property
+    def estimator(self) -> AltEstimator:
+        return self.core.estimator
 
     # ------------------------------------------------------------------ lifecycle
     def start(self) -> None:
@@ -189,19 +175,25 @@ class Station(StationIntents):
             self._finish()
             raise
 
-    def _stop_stepped(self) -> None:
-        """`stop()` of a station run by `run_tick`: land it on ticks of its own clock."""
-        if self._error is None and self.snapshot(loop_stats=False).state in LAND_UNTIL:
-            deadline = self.clock.now_s() + self.supervisor_params.quit_timeout_s
-            next_ask = self.clock.now_s()
-            while self.clock.now_s() < deadline:
-                if self.clock.now_s() >= next_ask:  # asked again each second, as below
-                    self._intents.put(Intent(IntentKind.QUIT))
-                    next_ask += 1.0
-                self.run_tick()
-                if self.snapshot(loop_stats=False).state in LAND_WAIT_STATES:
-                    break
-        self._finish()
+    def _land(self, now: Callable[[], float], advance: Callable[[float], None]) -> None:
+        """Land a vehicle that may fly before letting go: QUIT asked again each second (a QUIT
+        is ignored while the link is lost, and the link may come back with the vehicle still to
+        be landed) until the supervisor lets go or its quit timeout passes. `advance(until)`
+        lets the loop run: a tick of a stepped station, a wait on the loop thread's."""
+        if not must_land(self.snapshot(loop_stats=False).state):
+            return
+        deadline = now() + self.supervisor_params.quit_timeout_s
+        next_ask = now()
+        while now() < deadline:
+            if now() >= next_ask:
+                self._intents.put(Intent(IntentKind.QUIT))
+                next_ask += 1.0
+            advance(min(next_ask, deadline))
+            if may_leave(self.snapshot(loop_stats=False).state):
+                break
+
+    def _wait_until(self, until: float) -> None:
+        self.wait_for(lambda s: may_leave(s.state), until - time.monotonic())
 
     def _finish(self) -> None:
         self._let_go()
@@ -214,19 +206,12 @@ class Station(StationIntents):
         heartbeat, at most the supervisor's quit timeout); overrides are released only then."""
         if self._stepped:
             if self._running:
-                self._stop_stepped()
+                if self._error is None:
+                    self._land(self.clock.now_s, lambda _until: self.run_tick())
+                self._finish()
             return
-        alive = self._running and self._thread is not None and self._thread.is_alive()
-        flying = self.snapshot(loop_stats=False).state in LAND_UNTIL
-        if alive and flying:
-            deadline = time.monotonic() + self.supervisor_params.quit_timeout_s
-            # asked again each second: a QUIT is ignored while the link is lost, and the link
-            # may come back with the vehicle still to be landed
-            while time.monotonic() < deadline:
-                self._intents.put(Intent(IntentKind.QUIT))
-                if self.wait_for(lambda s: s.state in LAND_WAIT_STATES,
-                                 min(1.0, deadline - time.monotonic())) is not None:
-                    break
+        if self._running and self._thread is not None and self._thread.is_alive():
+            self._land(time.monotonic, self._wait_until)
         self.loop.stop()
         if self._thread is not None:
             self._thread.join(timeout_s)
@@ -285,7 +270,7 @@ class Station(StationIntents):
     def _emergency_land(self) -> None:
         """The loop crashed: ask for LAND (the supervisor's safe throttle, level) until a
         heartbeat shows it."""
-        if self.supervisor.state not in LAND_ON_DEATH:
+        if not self.core.lands_on_death:
             return
         hb = emergency_land(self.link, self._snapshot.safe_throttle_us,
                             self.config.period_s, speedup=getattr(self.clock, "speedup", 1.0))
@@ -336,37 +321,12 @@ class Station(StationIntents):
                 self._last_rx_s = max(self._last_rx_s, r.t_s)
         if self.mocap is not None:
             records = records + list(self.mocap.poll())
-        imus, sonars, attitude, baro = self._ingest(records)
-        hb = self._latest.get(Heartbeat)
-        hb = hb if isinstance(hb, Heartbeat) else None
-        status = VehicleStatus(
-            seen=hb is not None, armed=bool(hb and hb.armed), mode=hb.mode if hb else -1,
-            heartbeat_t_s=hb.t_s if hb else -NEVER_S,
-            frame_age_s=min(NEVER_S, t_s - self._last_rx_s))
-        # disarmed, the motors are stopped: the vehicle stands still (the estimator checks it
-        # is on the floor); before the first heartbeat nothing is known
-        at_rest = (status.seen and not status.armed
-                   and status.frame_age_s <= self.supervisor_params.lost_after_s)
-        est = self.estimator.update_tick(
-            imus, sonars, attitude, t_s, at_rest=at_rest,
-            baro_alt_m=None if baro is None else baro_altitude_m(baro.pressure_pa),
-            command_acc_mps2=self._out.command_acc_mps2 if self._out is not None else None)
-        self._estimate = est
-        att = self._latest.get(Attitude)
-        pose = self._latest.get(MocapPose)
-        out = self.supervisor.step(TickIn(
-            t_s=t_s, dt_s=dt_s, intents=tuple(intents), vehicle=status, estimate=est,
-            roll_rad=att.roll_rad if isinstance(att, Attitude) else 0.0,
-            pitch_rad=att.pitch_rad if isinstance(att, Attitude) else 0.0,
-            mocap=pose if isinstance(pose, MocapPose) else None))
-        self._out = out
-        if out.link is LinkHealth.LOST:
-            # the silence that made it "lost" counts too
-            first = self._out_link is not LinkHealth.LOST and status.frame_age_s < NEVER_S
-            self._link_down_s += dt_s + (status.frame_age_s if first else 0.0)
-        self._out_link = out.link
-        self._execute(t_s, out)
-        self._record_tick(t_s, k, dt_s, est, records, intents, status, out, at_rest)
+        self._ingest(records)
+        inputs = TickInputs.of(k, t_s, dt_s, self._vehicle_status(t_s), records, intents)
+        out = self.core.step(inputs)
+        self._execute(t_s, out.supervisor)
+        if self.recorder is not None:
+            record_tick(self.recorder, inputs, out, self.loop.last_timing)
         snap = self._make_snapshot(t_s, k)
         with self._lock:
             self._snapshot = snap
@@ -378,6 +338,15 @@ class Station(StationIntents):
                 if self._listener_errors == 1 or self._listener_errors % 100 == 0:
                     self._event(t_s, EventLevel.ERROR, f"listener failed "
                                 f"({self._listener_errors} so far): {type(exc).__name__}: {exc}")
+
+    def _vehicle_status(self, t_s: float) -> VehicleStatus:
+        """What the link knows of the vehicle at `t_s`: its last heartbeat, its last frame."""
+        hb = self._latest.get(Heartbeat)
+        hb = hb if isinstance(hb, Heartbeat) else None
+        return VehicleStatus(
+            seen=hb is not None, armed=bool(hb and hb.armed), mode=hb.mode if hb else -1,
+            heartbeat_t_s=hb.t_s if hb else -NEVER_S,
+            frame_age_s=min(NEVER_S, t_s - self._last_rx_s))
 
     def _execute(self, t_s: float, out: SupervisorOutput) -> None:
         link = self.link
@@ -406,12 +375,9 @@ class Station(StationIntents):
             self._event(t_s, EventLevel(int(note.level)), note.text)
         self._outcomes.extend(out.outcomes)
 
-    def _ingest(self, records: list[TelemetryRecord]) -> tuple[
-            list[Imu], list[Rangefinder], Attitude | None, Barometer | None]:
-        imus: list[Imu] = []
-        sonars: list[Rangefinder] = []
-        attitude: Attitude | None = None
-        baro: Barometer | None = None
+    def _ingest(self, records: list[TelemetryRecord]) -> None:
+        """Keep the newest of each record type, hand each to the record listeners, record it,
+        and tell the pilot what the link and the vehicle said."""
         rec = self.recorder
         for r in records:
             self._latest[type(r)] = r
@@ -426,15 +392,7 @@ class Station(StationIntents):
                 topic = topics.topic_for(r)
                 if topic is not None:
                     rec.put(topic, r.t_s, r)
-            if isinstance(r, Imu):
-                imus.append(r)
-            elif isinstance(r, Rangefinder):
-                sonars.append(r)
-            elif isinstance(r, Attitude):
-                attitude = r
-            elif isinstance(r, Barometer):
-                baro = r
-            elif isinstance(r, LinkEvent):
+            if isinstance(r, LinkEvent):
                 level = EventLevel.ERROR if r.kind is LinkEventKind.LOST else EventLevel.INFO
                 self._event(r.t_s, level, f"link {r.kind.value}: {r.detail}")
             elif isinstance(r, CommandAck) and r.result != 0:
@@ -443,22 +401,15 @@ class Station(StationIntents):
             elif isinstance(r, StatusText):
                 self._event(r.t_s, EventLevel.INFO if r.severity > 4 else EventLevel.WARNING,
                             f"vehicle: {r.text}")
-        return imus, sonars, attitude, baro
-
-    def _record_tick(self, t_s: float, k: int, dt_s: float, est: AltEstimate,
-                     records: list[TelemetryRecord], intents: list[Intent],
-                     status: VehicleStatus, out: SupervisorOutput, at_rest: bool) -> None:
-        if self.recorder is not None:
-            record_tick(self.recorder, TickRecord(
-                t_s, k, dt_s, est, records, intents, status, out, at_rest, self.supervisor.alt,
-                self.supervisor.position, self.loop.last_timing))
 
     def _make_snapshot(self, t_s: float, k: int) -> StationSnapshot:
-        sup = self.supervisor
+        sup = self.core.supervisor
         latest = dict(self._latest)
         hb = latest.get(Heartbeat)
         hb = hb if isinstance(hb, Heartbeat) else None
-        out = self._out
+        last = self.core.last
+        out = last.supervisor if last is not None else None
+        estimate = last.estimate if last is not None else None
 
         def get(cls: type) -> Any:
             r = latest.get(cls)
@@ -481,7 +432,7 @@ class Station(StationIntents):
             mocap=get(MocapPose),
             truth=get(SimTruth),
             latest=latest,
-            estimate=self._estimate,
+            estimate=estimate,
             alt_setpoint_m=out.alt_setpoint_m if out is not None else None,
             position_setpoint=sup.pos_setpoint if sup.state is SupervisorState.HOLD else None,
             alt=sup.alt,
@@ -489,13 +440,13 @@ class Station(StationIntents):
             command=sup.command,
             sticks=sup.sticks,
             throttle_gate_us=out.throttle_gate_us if out is not None else None,
-            hover_throttle=self.alt_ctrl.hover_throttle,
+            hover_throttle=self.core.alt_ctrl.hover_throttle,
             loop=self._empty_stats if k < 0 else self._snapshot.loop,
             link_stats=self.link.stats,
             events=tuple(self._events),
             listener_errors=self._listener_errors,
-            link_down_s=self._link_down_s,
-            safe_throttle_us=(sup.safe_throttle_us(self._estimate.alt_m)
-                              if self._estimate is not None else STICK_MIN_US),
+            link_down_s=last.link_down_s if last is not None else 0.0,
+            safe_throttle_us=(sup.safe_throttle_us(estimate.alt_m)
+                              if estimate is not None else STICK_MIN_US),
             outcomes=tuple(self._outcomes),
         )

@@ -23,9 +23,6 @@ from gcs.estimation import AltEstimate
 from gcs.station.loop import LoopStats
 from gcs.supervisor import LinkHealth, Outcome, SupervisorState
 
-NEVER_S = 1.0e9
-"""Stand-in for 'never' in recorded times: finite, so a recording gives it back unchanged."""
-
 
 class ControlMode(enum.Enum):
     """Who makes the throttle, as a display sees it (derived from the supervisor's state)."""
@@ -112,32 +109,6 @@ class StationSetup:
     curve_json: str  # ThrottleCurve as gcs.params_json text
     hover_throttle: float  # the altitude controller's starting hover throttle
     supervisor_json: str = ""  # SupervisorParams as gcs.params_json text
-
-
-@dataclass(frozen=True, slots=True)
-class TickInputs:
-    """/gcs/tick payload: what one tick consumed, so a rerun can feed the supervisor exactly.
-
-    The `*_n` counts are how many records of each type (and intents) this tick ingested: the
-    next ones, in recorded order, on their topics."""
-
-    tick: int
-    t_s: float
-    dt_s: float
-    imu_n: int
-    rangefinder_n: int
-    attitude_n: int
-    mocap_n: int
-    baro_n: int
-    intent_n: int
-    at_rest: bool  # disarmed: the estimator was told the vehicle stands still
-    vehicle_seen: bool
-    armed: bool
-    vehicle_mode: int
-    heartbeat_t_s: float
-    frame_age_s: float
-    state: SupervisorState  # after the tick
-    link_lost: bool
 
 
 class Recorder(Protocol):

@@ -16,6 +16,7 @@ from gcs import params_json, topics
 from gcs.cli import main
 from gcs.clock import SimClock
 from gcs.config import EstimatorKind, StationConfig
+from gcs.core import TickRecord
 from gcs.errors import UsageError
 from gcs.rerun import (
     RerunReport,
@@ -26,7 +27,7 @@ from gcs.rerun import (
     parse_gains,
     rerun,
 )
-from gcs.station.station import Station, StationSetup, TickInputs
+from gcs.station.station import Station, StationSetup
 from logs import Recorder, open_recording
 from tests.gcs.test_station import FakeBoard
 
@@ -240,7 +241,7 @@ def test_recordings_that_cannot_be_rerun(tmp_path: Path,
         setup = StationSetup(params_json.dumps(st.config), params_json.dumps(st.curve), 0.5,
                              params_json.dumps(st.supervisor_params))
         rec.put(topics.SETUP, 1.0, setup)
-        rec.put(topics.TICK, 1.0, TickInputs(0, 1.0, 0.025, 3, 0, 0, 0, 0, 0, False, True,
+        rec.put(topics.TICK, 1.0, TickRecord(0, 1.0, 0.025, 3, 0, 0, 0, 0, 0, False, True,
                                              False, 0, 1.0, 0.0, st.snapshot().state, False))
         rec.put(topics.ESTIMATE, 1.0, {"alt_m": 0.0})
     with pytest.raises(UsageError, match="ran out of"):

@@ -172,7 +172,7 @@ def test_downlink_loss_lands_then_goes_silent_and_does_not_resume() -> None:
     assert st.snapshot().state is SupervisorState.LINK_LOST
     assert FlightMode.LAND in board.modes
     held = board.overrides[-1]
-    assert held.throttle_us == st.alt_ctrl.hover_stick_us() and held.roll_us == 1500
+    assert held.throttle_us == st.core.alt_ctrl.hover_stick_us() and held.roll_us == 1500
     run_s(st, 3.5)
     assert st.snapshot().state is SupervisorState.SILENT
     n1 = len(board.overrides)
