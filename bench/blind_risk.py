@@ -39,6 +39,7 @@ from gcs.lockstep_session import LockstepSession
 from gcs.station.session import SessionOptions
 from gcs.supervisor.envelope import blind_touchdown
 from gcs.supervisor.params import SupervisorParams
+from lab.lockstep import install
 from logs import open_recording
 
 SETPOINT_M = 1.0
@@ -106,4 +107,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    install()  # lockstep flights fly the bundled SITL in this process
     sys.exit(main())

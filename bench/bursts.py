@@ -35,6 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from gcs.cli import build_parser  # noqa: E402
 from gcs.commands.fly import fly  # noqa: E402
+from lab.lockstep import install  # noqa: E402
 from tests.e2e.sitl_proc import SitlProcess, starved  # noqa: E402
 from tests.gcs.test_estimation_bursts import fly_bursts  # noqa: E402
 from tests.gcs.test_stalled_sitl import fly_stalled  # noqa: E402
@@ -119,4 +120,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    install()  # lockstep flights fly the bundled SITL in this process
     raise SystemExit(main())

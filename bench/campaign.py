@@ -30,11 +30,12 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from gcs.campaign import load_campaign, ray_session, run_campaign
 from gcs.commands.fly import fly_session
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
 from gcs.station.session import SessionOptions
+from lab.campaign import load_campaign, ray_session, run_campaign
+from lab.lockstep import install
 from sitl import native
 
 HOLD_S = 30.0
@@ -147,4 +148,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    install()  # lockstep flights fly the bundled SITL in this process
     main()

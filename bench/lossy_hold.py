@@ -29,6 +29,7 @@ from gcs.errors import FlightFailed
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
 from gcs.station.session import SessionOptions
+from lab.lockstep import install
 
 LOSS = 1.0 - 0.7 * 0.95
 LOSS_START_S = 40.0
@@ -88,4 +89,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    install()  # lockstep flights fly the bundled SITL in this process
     sys.exit(main())

@@ -32,6 +32,7 @@ from gcs.errors import FlightFailed
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
 from gcs.station.session import SessionOptions
+from lab.lockstep import install
 
 FADE_START_S = 40.0
 FADE_S = 15.0
@@ -114,4 +115,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    install()  # lockstep flights fly the bundled SITL in this process
     sys.exit(main())

@@ -74,7 +74,7 @@ def fly(name: str, args: list[str], workdir: Path) -> dict[str, Any]:
     """Fly one fixed flight; its summary's and recordings' hashes."""
     out = workdir / name
     out.mkdir()
-    cmd = [sys.executable, "-m", "gcs", *args, "-o", str(out), "--json"]
+    cmd = [sys.executable, "-m", "lab", *args, "-o", str(out), "--json"]
     if args[0] == "mission":
         cmd.append("--quiet")
     done = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, check=False)

@@ -28,6 +28,7 @@ from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
 from gcs.scoring import takeoff_peak_m
 from gcs.station.session import SessionOptions
+from lab.lockstep import install
 from logs import open_recording
 
 TARGETS_M = (1.0, 2.0)
@@ -72,4 +73,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    install()  # lockstep flights fly the bundled SITL in this process
     sys.exit(main())

@@ -13,11 +13,11 @@ import argparse
 import asyncio
 import time
 
+from gcs.pilot import intents
+from gcs.pilot.view import LoopView
 from gcs.station.session import SessionOptions
-from gcs.tui import intents
 from gcs.tui.app import make_app
 from gcs.tui.process_backend import ProcessBackend
-from gcs.tui.view import LoopView
 
 
 def wait_view(backend: ProcessBackend, cond, timeout_s: float) -> None:  # type: ignore[no-untyped-def]

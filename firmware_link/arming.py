@@ -22,6 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 from firmware_link.errors import LinkError, LinkUsageError
+from firmware_link.pwm import clamp_pwm_us
 from firmware_link.records import CommandAck, Dialect, FlightMode, RcCommand, StatusText
 
 MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
@@ -30,8 +31,6 @@ MAV_CMD_DO_SET_MODE = 176
 SET_MODE_MSG_ID = 11  # ArduCopter acknowledges SET_MODE with this "command"
 FORCE_ARM_MAGIC = 2989.0
 FORCE_DISARM_MAGIC = 21196.0
-RC_MIN_US = 1000
-RC_MAX_US = 2000
 RC_RELEASE = 0
 RC_LEAVE_ALONE = 65535
 ARM_RETRY_S = 1.0  # between a refusal and the next request
@@ -51,13 +50,6 @@ class MavResult:
 
 
 RESULT_TEXT = {1: "temporarily rejected", 2: "denied", 3: "unsupported", 4: "failed"}
-
-
-def clamp_pwm_us(value: float) -> int:
-    """A stick value clamped to 1000..2000 µs (NaN → 1500, the centre)."""
-    if math.isnan(value):
-        return (RC_MIN_US + RC_MAX_US) // 2
-    return int(min(RC_MAX_US, max(RC_MIN_US, round(value))))
 
 
 def one_line(text: str) -> str:

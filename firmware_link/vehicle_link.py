@@ -22,7 +22,7 @@ from collections.abc import Callable
 from types import TracebackType
 from typing import Any
 
-from firmware_link.arming import ArmingAndModes, MavResult, clamp_pwm_us
+from firmware_link.arming import ArmingAndModes, MavResult
 from firmware_link.bring_up import StreamBringUp
 from firmware_link.connection import ConnectionSpec, parse_connection_string
 from firmware_link.dialect import MAVLINK1_CANNOT_SIGN
@@ -34,6 +34,7 @@ from firmware_link.identify import Identification
 from firmware_link.link_core import MAV_AUTOPILOT_INVALID, MAV_TYPE_GCS, LinkCore
 from firmware_link.params import ParamProtocol
 from firmware_link.protocol import WireVersion
+from firmware_link.pwm import clamp_pwm_us
 from firmware_link.records import LinkEventKind
 from firmware_link.signing import KEY_BYTES, signing_timestamp
 from firmware_link.transport import ByteTransport, TransportClosed, open_transport

@@ -1,4 +1,5 @@
-"""`python -m gcs` is the same as the `quadgcs` console script."""
+"""`python -m gcs`: the station's command line alone (no bundled SITL in this process, so no
+lockstep flights or campaigns; the `quadgcs` console script, `python -m lab`, has them)."""
 
 import sys
 

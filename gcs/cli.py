@@ -1,6 +1,9 @@
-"""The `quadgcs` console script: one entry point, one module per subcommand.
+"""The station's command line: one entry point, one module per subcommand.
 
-Each module in `gcs.commands` exposes `register(subparsers)`, which adds its parser and sets
+`python -m gcs` is the station alone: it flies vehicles and the SITL as a separate program. The
+`quadgcs` console script (`lab.cli`) is this plus what needs the bundled SITL in this process
+(lockstep flights, campaigns). Each module in `gcs.commands` (and each extra module the caller
+names) exposes `register(subparsers)`, which adds its parser and sets
 `func` (taking the parsed namespace, returning an exit code). Expected errors derive from
 `gcs.errors.QuadgcsError` and end as one line on stderr with their exit code.
 """
@@ -27,12 +30,12 @@ COMMAND_MODULES: tuple[str, ...] = (
     "logs",
     "bench",
     "params",
-    "campaign",
 )
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """Build the top-level parser with every available subcommand registered."""
+def build_parser(extra: Sequence[str] = ()) -> argparse.ArgumentParser:
+    """Build the top-level parser with every available subcommand registered, and those of the
+    modules named in `extra` (dotted names) after them."""
     parser = argparse.ArgumentParser(
         prog="quadgcs",
         description="Ground-control station for small indoor quadrotors (MAVLink, ArduCopter).",
@@ -42,8 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="print the installed version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND",
                                 help="what to do (quadgcs COMMAND --help for its flags)")
-    for name in COMMAND_MODULES:
-        module_name = f"gcs.commands.{name}"
+    for module_name in (*(f"gcs.commands.{name}" for name in COMMAND_MODULES), *extra):
         try:
             module = importlib.import_module(module_name)
         except ModuleNotFoundError as exc:
@@ -55,9 +57,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None, extra: Sequence[str] = ()) -> int:
     """Run one subcommand; return its exit code (2 for usage errors)."""
-    parser = build_parser()
+    parser = build_parser(extra)
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help(sys.stderr)

@@ -1,31 +1,27 @@
-"""Lockstep flights: the station and the bundled SITL in one process, on one simulated clock.
+"""Lockstep flights: the station and a simulator in one process, on one simulated clock.
 
 Over TCP the SITL is a separate program that keeps its own time; in lockstep it is a library
-whose time the station drives (`sitl.lockstep`): `LockstepClock.sleep_until(t)` is the
-simulation running up to `t`, so the loop's wait for its next tick, the link's wait for bytes
-and a flight's wait for the vehicle all cost only the CPU the simulation needs. Nothing waits on
-the wall clock and no thread is involved, so a seed flies the same flight bit for bit.
+whose time the station drives: `LockstepClock.sleep_until(t)` is the simulation running up to
+`t`, so the loop's wait for its next tick, the link's wait for bytes and a flight's wait for the
+vehicle all cost only the CPU the simulation needs. Nothing waits on the wall clock and no
+thread is involved, so a seed flies the same flight bit for bit.
 
-The station still learns everything from MAVLink bytes: the SITL's ports are plugged in as
+The station still learns everything from MAVLink bytes: the simulator's ports are plugged in as
 `mem:` connection strings (`firmware_link.memory`) and the station opens them with the same
-`VehicleLink`, `MocapLink` and `TruthLink` it uses over TCP. The SITL is loaded by name, as
-`SitlProcess` starts it by name: nothing else of it is imported.
+`VehicleLink`, `MocapLink` and `TruthLink` it uses over TCP. The station never imports the
+simulator: the program that has both (`lab`, the `quadgcs` console script) hands its opener to
+`use_simulator`; without one, a lockstep flight is refused with one line.
 """
 
 from __future__ import annotations
 
 import contextlib
-import importlib
-import itertools
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Protocol
 
-from firmware_link import memory
 from firmware_link.truth_link import TruthLink, TruthReport
 from gcs.errors import UsageError
-
-_instances = itertools.count(1)
 
 
 class Timeline(Protocol):
@@ -70,63 +66,49 @@ class LockstepOptions:
     faults: dict[str, Any] | None = None
 
 
-def _faulty_sysids(given: Any, vehicles: int) -> set[int]:
-    """The sysids a fault hits: every vehicle, or those listed (each one of them)."""
-    every = set(range(1, vehicles + 1))
-    if given is None:
-        return every
-    listed = [given] if isinstance(given, int) else given
-    if (not isinstance(listed, list | tuple) or not listed
-            or not all(isinstance(v, int) and not isinstance(v, bool) for v in listed)
-            or not set(listed) <= every):
-        raise ValueError(f"faults' vehicles {given!r}: expected sysids among 1..{vehicles}")
-    return set(listed)
+class LockstepSimulator(Protocol):
+    """A simulator running in this process, its ports plugged in as `mem:` connection strings
+    (`lab.lockstep.BundledLockstep`)."""
+
+    @property
+    def sitl(self) -> Timeline: ...
+
+    @property
+    def clock(self) -> LockstepClock: ...
+
+    @property
+    def mocaps(self) -> Mapping[int, str]: ...
+
+    @property
+    def truth(self) -> str | None: ...
+
+    def url(self, sysid: int = 1) -> str: ...
+
+    def close(self) -> None: ...
 
 
-class BundledLockstep:
-    """The bundled SITL in this process: its ports plugged in as `mem:` connection strings."""
+SimulatorOpener = Callable[[LockstepOptions], LockstepSimulator]
 
-    def __init__(self, options: LockstepOptions) -> None:
-        module = importlib.import_module("sitl.lockstep")
-        try:
-            self.sitl = module.start(options.profile, options.world, options.vehicles,
-                                     options.seed, options.noise, options.signing_key)
-            given = dict(options.faults or {})
-            hit = _faulty_sysids(given.pop("vehicles", None), options.vehicles)
-            stall = given.pop("stall", None)
-            if stall is not None:
-                self.sitl.stall = module.Stall(*stall)
-            faults = module.LinkFaults(**{"seed": options.seed, **given}) if given else None
-        except (ValueError, OSError, TypeError) as exc:
-            where = f"--world {options.world}: " if isinstance(options.world, Path) else ""
-            raise UsageError(f"{where}{exc}") from None
-        self.clock = LockstepClock(self.sitl)
-        self._prefix = f"lockstep{next(_instances)}"
-        self._names: list[str] = []
-        self.ports = {s: self.sitl.vehicle_port(s, faults if s in hit else None)
-                      for s in range(1, options.vehicles + 1)}
-        self.vehicles = {s: self._plug(f"vehicle{s}", p) for s, p in self.ports.items()}
-        # one motion-capture client per vehicle, as over TCP: readers of one pipe would share
-        # out its bytes between them
-        self.mocaps = ({s: self._plug(f"mocap{s}", self.sitl.mocap_port()) for s in self.ports}
-                       if self.sitl.mocap_enabled else {})
-        self.mocap = self.mocaps.get(1)
-        self.truth = self._plug("truth", self.sitl.truth_port()) if options.truth else None
+_openers: list[SimulatorOpener] = []
 
-    def _plug(self, what: str, port: Any) -> str:
-        name = f"{self._prefix}/{what}"
-        self._names.append(name)
-        return memory.plug(name, port)
 
-    def url(self, sysid: int = 1) -> str:
-        """The vehicle's connection string."""
-        return self.vehicles[sysid]
+def use_simulator(opener: SimulatorOpener) -> None:
+    """Fly lockstep flights on what `opener` starts (the program that has a simulator calls
+    this once, before any flight)."""
+    if opener not in _openers:
+        _openers.append(opener)
 
-    def close(self) -> None:
-        """Unplug every port (the simulation itself is garbage once nobody holds it)."""
-        for name in self._names:
-            memory.unplug(name)
-        self._names.clear()
+
+def open_simulator(options: LockstepOptions) -> LockstepSimulator:
+    """The simulator for a lockstep flight (UsageError when this program has none)."""
+    if not _openers:
+        raise UsageError("--lockstep: this program has no simulator of its own; run it as "
+                         "quadgcs (or python -m lab), which brings the bundled SITL")
+    return _openers[-1](options)
+
+
+BundledLockstep = open_simulator
+"""The name `LockstepSession` opens its simulator by."""
 
 
 class SteppedTruth:

@@ -1,7 +1,7 @@
 """Gamepad teleop: SDL2 pads mapped by a TOML file onto the pilot's intents.
 
 - `mapping`: the TOML format, the bundled entries (`pads.toml`) and their checks;
-- `core`: pure — shaped sticks and button presses to `gcs.tui.intents`, and the unplug policy;
+- `core`: pure — shaped sticks and button presses to `gcs.pilot.intents`, and the unplug policy;
 - `sdl_pad`: SDL at the edge (pysdl2 + pysdl2-dll), hot-plug included;
 - `driver`: the pad as the teleop app polls it.
 """

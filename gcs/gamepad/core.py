@@ -1,7 +1,7 @@
 """The pure part of gamepad teleop: stick positions and buttons in, pilot intents out.
 
 No SDL and no clock: each `step` gets the time, one sample of the pad (or None when it is
-unplugged) and what the UI last heard from the vehicle, and returns the `gcs.tui.intents` to
+unplugged) and what the UI last heard from the vehicle, and returns the `gcs.pilot.intents` to
 send. The supervisor still decides what is safe; this module only decides what the pilot's pad
 asks for, and what it asks for when the pad goes away.
 
@@ -27,12 +27,13 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from firmware_link.pwm import PWM_MAX_US, PWM_MID_US, PWM_MIN_US
 from gcs.gamepad.mapping import PadSettings
-from gcs.tui import intents
+from gcs.pilot import intents
 
-THROTTLE_MIN_US = 1000
-THROTTLE_MID_US = 1500
-THROTTLE_MAX_US = 2000
+THROTTLE_MIN_US = PWM_MIN_US
+THROTTLE_MID_US = PWM_MID_US
+THROTTLE_MAX_US = PWM_MAX_US
 THROTTLE_SPAN_US = 500
 PICKUP_BAND_US = 40  # how close the pad's throttle must come to the one the station holds
 LAND_RESEND_S = 1.0  # a SET_MODE can be lost on the link; ask again until LAND is seen

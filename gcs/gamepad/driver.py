@@ -10,8 +10,8 @@ from typing import Protocol
 
 from gcs.gamepad.core import GamepadPilot, PadSample, PadStatus, VehicleState
 from gcs.gamepad.mapping import PadMapping, PadSettings
-from gcs.tui import intents
-from gcs.tui.view import TeleopView
+from gcs.pilot import intents
+from gcs.pilot.view import TeleopView
 
 
 class PadSource(Protocol):

@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import queue
 
+from firmware_link.pwm import PWM_MAX_US, PWM_MIN_US
 from firmware_link.records import FlightMode
 from gcs.control.position_controller import PositionSetpoint
 from gcs.supervisor import Intent, IntentKind
 
-STICK_MIN_US, STICK_MAX_US = 1000, 2000
+STICK_MIN_US, STICK_MAX_US = PWM_MIN_US, PWM_MAX_US
 
 
 def _clamp_us(v: int) -> int:

@@ -10,11 +10,12 @@ import enum
 import math
 from dataclasses import dataclass
 
+from firmware_link.pwm import PWM_MAX_US, PWM_MID_US, PWM_MIN_US
 from firmware_link.records import FlightMode, MocapPose, RcCommand
 from gcs.estimation import AltEstimate
 from gcs.supervisor.outcomes import Outcome
 
-STICK_MIN_US, STICK_MID_US, STICK_MAX_US = 1000, 1500, 2000
+STICK_MIN_US, STICK_MID_US, STICK_MAX_US = PWM_MIN_US, PWM_MID_US, PWM_MAX_US
 
 
 class SupervisorState(enum.Enum):

@@ -18,12 +18,12 @@ from textual.containers import Horizontal
 from textual.widgets import Footer, RichLog
 
 from gcs.gamepad.driver import Gamepad
-from gcs.tui import intents
+from gcs.pilot import intents
+from gcs.pilot.view import TeleopView
 from gcs.tui.backend import TeleopBackend
 from gcs.tui.help import ConfirmQuit, HelpScreen, describe
 from gcs.tui.pad_panel import PadPanel
 from gcs.tui.sticks import Sticks
-from gcs.tui.view import TeleopView
 from gcs.tui.widgets import AccelPlot, AltitudePanel, HeightPlot, LinkPanel, VehiclePanel
 
 REDRAW_HZ = 8.0

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from gcs.tui.intents import Intent
-from gcs.tui.view import TeleopView
+from gcs.pilot.intents import Intent
+from gcs.pilot.view import TeleopView
 
 
 class TeleopBackend(Protocol):

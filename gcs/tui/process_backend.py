@@ -19,9 +19,9 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 from gcs.errors import QuadgcsError, RuntimeFault, UsageError
+from gcs.pilot import intents
+from gcs.pilot.view import TeleopView
 from gcs.station.session import SessionOptions, StationSession
-from gcs.tui import intents
-from gcs.tui.view import TeleopView
 
 VIEW_PERIOD_S = 0.1
 START_TIMEOUT_S = 60.0

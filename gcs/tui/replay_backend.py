@@ -14,8 +14,8 @@ from typing import Any
 
 from firmware_link.records import FlightMode
 from gcs import topics
-from gcs.tui import intents
-from gcs.tui.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView
+from gcs.pilot import intents
+from gcs.pilot.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView
 from logs.replay import Player, ReplayMessage
 
 HISTORY_POINTS = 300

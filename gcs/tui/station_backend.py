@@ -13,10 +13,10 @@ from collections import deque
 
 from firmware_link.records import FlightMode, Rangefinder, SystemStatus
 from gcs.estimation import DeadReckoningEstimator
+from gcs.pilot import intents
+from gcs.pilot.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView
 from gcs.station.station import ControlMode, Station, StationSnapshot
-from gcs.tui import intents
 from gcs.tui.sticks import stick_to_pwm
-from gcs.tui.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView
 
 HISTORY_S = 30.0
 HISTORY_EVERY_TICKS = 4  # 10 Hz of plot points at the 25 ms loop: two per column is plenty

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from firmware_link.pwm import PWM_MAX_US, PWM_MIN_US
+
 
 @dataclass(frozen=True, slots=True)
 class StickParams:
@@ -30,7 +32,7 @@ class Sticks:
     """Roll, pitch and yaw in -1..1 (self-centring) and a throttle that stays where it is put."""
 
     params: StickParams = field(default_factory=StickParams)
-    throttle_us: int = 1000
+    throttle_us: int = PWM_MIN_US
     _axes: dict[str, _Axis] = field(default_factory=lambda: {a: _Axis() for a in AXES})
 
     def push(self, axis: str, direction: int, t_s: float) -> None:
@@ -43,11 +45,11 @@ class Sticks:
     def nudge_throttle(self, direction: int) -> None:
         """Move the throttle one step up (+1) or down (-1), within 1000..2000 µs."""
         step = direction * self.params.throttle_step_us
-        self.throttle_us = max(1000, min(2000, self.throttle_us + step))
+        self.throttle_us = max(PWM_MIN_US, min(PWM_MAX_US, self.throttle_us + step))
 
     def cut(self) -> None:
         """Throttle to minimum and every stick to centre (emergency kill)."""
-        self.throttle_us = 1000
+        self.throttle_us = PWM_MIN_US
         for state in self._axes.values():
             state.value = 0.0
             state.pressed_at_s = float("-inf")

@@ -7,7 +7,7 @@ from textual.reactive import reactive
 from textual.widgets import Static
 from textual_plotext import PlotextPlot
 
-from gcs.tui.view import TeleopView, fmt
+from gcs.pilot.view import TeleopView, fmt
 
 # About two points per terminal column keeps a plotext redraw cheap (≈10 ms at 100 points).
 PLOT_WINDOW_S = 20.0

@@ -36,7 +36,7 @@ def test_lockstep_hold_agrees_with_tcp_at_1x() -> None:
                 for s in SEEDS]
     tcp = []
     for batch in (SEEDS[:4], SEEDS[4:]):
-        procs = [subprocess.Popen([sys.executable, "-m", "gcs", "fly", "--seed", str(s), *PLAN],
+        procs = [subprocess.Popen([sys.executable, "-m", "lab", "fly", "--seed", str(s), *PLAN],
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                   cwd=ROOT) for s in batch]
         for p in procs:

@@ -19,7 +19,7 @@ MISSION = Path(__file__).resolve().parents[2] / "missions" / "epbha_table.toml"
 
 def _run(out: Path, *extra: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "gcs", "mission", "run", str(MISSION), "--lockstep",
+        [sys.executable, "-m", "lab", "mission", "run", str(MISSION), "--lockstep",
          "--json", "-o", str(out), *extra],
         capture_output=True, text=True, timeout=120, check=False)
 

@@ -35,7 +35,7 @@ def _mission(tmp_path: Path, name: str, edits: dict[str, str]) -> Path:
 
 def _run(mission: Path, out: Path, mode: str) -> dict[str, Any]:
     proc = subprocess.run(
-        [sys.executable, "-m", "gcs", "mission", "run", str(mission), mode, "--seed", "3",
+        [sys.executable, "-m", "lab", "mission", "run", str(mission), mode, "--seed", "3",
          "--json", "-q", "-o", str(out)],
         capture_output=True, text=True, timeout=300, check=False)
     lines = proc.stdout.strip().splitlines()

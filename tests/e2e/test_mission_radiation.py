@@ -78,7 +78,7 @@ def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
     mission = tmp_path / "small_pack_mission.toml"
     mission.write_text(text)
     proc = subprocess.run(
-        [sys.executable, "-m", "gcs", "mission", "run", str(mission), "--lockstep", "--seed", "5",
+        [sys.executable, "-m", "lab", "mission", "run", str(mission), "--lockstep", "--seed", "5",
          "--json", "-o", str(tmp_path), "--plot", str(tmp_path / "p.png")],
         capture_output=True, text=True, timeout=200, check=False, cwd=ROOT)
     out = proc.stdout.strip().splitlines()

@@ -20,11 +20,11 @@ from gcs.gamepad.core import PadPhase
 from gcs.gamepad.driver import Gamepad
 from gcs.gamepad.mapping import load_mappings
 from gcs.gamepad.sdl_pad import SdlPad
+from gcs.pilot.view import TeleopView
 from gcs.station.session import SessionOptions
 from gcs.tui.app import TeleopApp, make_app
 from gcs.tui.pad_panel import PadPanel
 from gcs.tui.process_backend import ProcessBackend
-from gcs.tui.view import TeleopView
 from tests.e2e.test_teleop_tui import truth_alt, wait_until
 from tests.gamepad.virtual_pad import VirtualPad
 

@@ -12,10 +12,10 @@ from pathlib import Path
 
 import pytest
 
+from gcs.pilot.view import TeleopView
 from gcs.station.session import SessionOptions
 from gcs.tui.app import make_app
 from gcs.tui.process_backend import ProcessBackend
-from gcs.tui.view import TeleopView
 
 pytestmark = pytest.mark.e2e
 

@@ -7,7 +7,7 @@ import pytest
 
 from gcs.gamepad.core import GamepadPilot, PadPhase, PadSample, VehicleState, shape
 from gcs.gamepad.mapping import PadSettings
-from gcs.tui import intents
+from gcs.pilot import intents
 
 DT = 0.02
 DISARMED = VehicleState()

@@ -89,7 +89,8 @@ def test_lockstep_refuses_what_it_cannot_fly(flag: list[str],
 
 def test_a_fault_hits_only_the_vehicles_it_names() -> None:
     from gcs.errors import UsageError
-    from gcs.lockstep import BundledLockstep, LockstepOptions
+    from gcs.lockstep import LockstepOptions
+    from lab.lockstep import BundledLockstep
 
     sim = BundledLockstep(LockstepOptions(vehicles=2, faults={
         "fade": "down", "fade_start_s": 0.0, "fade_s": 100.0, "vehicles": [2]}))

@@ -98,7 +98,7 @@ def test_the_switch_loads_every_module_from_source() -> None:
 
 def _fly(out: Path, env: dict[str, str]) -> list[tuple[str, int, bytes]]:
     proc = subprocess.run(
-        [sys.executable, "-m", "gcs", "fly", "--lockstep", "--seed", "4", "--hold", "5",
+        [sys.executable, "-m", "lab", "fly", "--lockstep", "--seed", "4", "--hold", "5",
          "--json", "-o", str(out)],
         capture_output=True, text=True, timeout=120, check=False,
         env={**os.environ, **env})

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from gcs.tui import intents
-from gcs.tui.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView
+from gcs.pilot import intents
+from gcs.pilot.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView
 
 
 def fixed_view() -> TeleopView:

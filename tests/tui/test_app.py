@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from gcs.tui import intents
+from gcs.pilot import intents
 from gcs.tui.app import make_app
 from tests.tui.conftest import FixedBackend
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from gcs.gamepad.core import PadSample, VehicleState
 from gcs.gamepad.driver import Gamepad
 from gcs.gamepad.mapping import PadMapping, PadSettings, load_mappings
-from gcs.tui import intents
+from gcs.pilot import intents
 from gcs.tui.app import make_app
 from gcs.tui.pad_panel import PadPanel, gauge
 from tests.tui.conftest import FixedBackend

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from gcs.tui.view import LinkView, TeleopView
+from gcs.pilot.view import LinkView, TeleopView
 from gcs.tui.widgets import LinkPanel
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from firmware_link.records import Attitude, Heartbeat, Rangefinder, SimTruth, SystemStatus
 from gcs import topics
-from gcs.tui import intents
+from gcs.pilot import intents
 from gcs.tui.app import make_app
 from gcs.tui.replay_backend import ReplayBackend
 from logs import Recorder, open_recording

@@ -14,12 +14,13 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from gcs.campaign.metrics import failed_row, flown_row
-from gcs.campaign.spec import BaseFlight, BaseMission
-from gcs.campaign.tables import set_dotted, station_table, world_table
 from gcs.config import config_from_table
 from gcs.flight import FlightPlan
 from gcs.station.session import SessionOptions
+from lab.campaign.metrics import failed_row, flown_row
+from lab.campaign.spec import BaseFlight, BaseMission
+from lab.campaign.tables import set_dotted, station_table, world_table
+from lab.lockstep import install
 from sitl import native
 
 
@@ -65,6 +66,8 @@ def fly_run(base: BaseFlight, run: RunSpec, output: Path, campaign: str) -> dict
     """Fly one run in lockstep; its row (status "ok", or "failed" with the reason)."""
     from gcs.commands.fly import fly_session
     from gcs.lockstep_session import LockstepSession
+
+    install()  # a worker process flies lockstep on the bundled SITL
 
     c0, w0 = time.process_time(), time.perf_counter()
     values = run.values

@@ -8,7 +8,7 @@ RAY_ADDRESS). Results: one row per run in OUTPUT/results.parquet (and .csv with 
 on stdout, PNG plots in OUTPUT/plots. Re-running the same file resumes: runs already in the
 results are skipped. Ctrl-C stops and keeps every finished run. `kind = "search"` tunes the
 axes with Optuna (TPE) and writes OUTPUT/best_station.toml for `quadgcs fly --config`.
-See gcs/campaign/spec.py and campaigns/ for the file format.
+See lab/campaign/spec.py and campaigns/ for the file format.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from gcs.errors import UsageError
 DEFAULT_OUTPUT = Path("flights") / "campaigns"
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `campaign` subcommand."""
     p = sub.add_parser("campaign", help="fly a campaign file's seeded lockstep runs on Ray",
                        description=__doc__,
@@ -43,7 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """CLI entry: load, fly on Ray, print the summary; 130 when interrupted."""
-    from gcs.campaign import (
+    from lab.campaign import (
         BaseMission,
         load_campaign,
         mission_summary_table,
@@ -52,8 +52,8 @@ def run(args: argparse.Namespace) -> int:
         run_search,
         summary_table,
     )
-    from gcs.campaign.plots import axis_plots
-    from gcs.campaign.pool import need
+    from lab.campaign.plots import axis_plots
+    from lab.campaign.pool import need
 
     c = load_campaign(args.file)
     need("pyarrow")  # the results file: before any run, not after the first

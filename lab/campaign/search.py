@@ -16,16 +16,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from gcs.campaign.driver import Outcome, RowKeeper
-from gcs.campaign.metrics import OK
-from gcs.campaign.plots import history_plot
-from gcs.campaign.pool import need, run_all
-from gcs.campaign.progress import Progress
-from gcs.campaign.results import RESULTS_NAME, read_results
-from gcs.campaign.run import RunSpec, fly_run, make_run
-from gcs.campaign.spec import BaseFlight, Campaign, Range
-from gcs.campaign.tables import dumps, set_dotted, station_table
 from gcs.errors import RuntimeFault
+from lab.campaign.driver import Outcome, RowKeeper
+from lab.campaign.metrics import OK
+from lab.campaign.plots import history_plot
+from lab.campaign.pool import need, run_all
+from lab.campaign.progress import Progress
+from lab.campaign.results import RESULTS_NAME, read_results
+from lab.campaign.run import RunSpec, fly_run, make_run
+from lab.campaign.spec import BaseFlight, Campaign, Range
+from lab.campaign.tables import dumps, set_dotted, station_table
 
 BEST_NAME = "best_station.toml"
 HISTORY_NAME = "search_history.png"

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from gcs.campaign.metrics import COLUMNS, NUMERIC_METRICS, OK
+from lab.campaign.metrics import COLUMNS, NUMERIC_METRICS, OK
 
 RESULTS_NAME = "results.parquet"
 

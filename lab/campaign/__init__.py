@@ -6,16 +6,16 @@ rows (`read_results`), summarised by `summary_table` (`mission_summary_table`) a
 `axis_plots`.
 """
 
-from gcs.campaign.driver import Outcome, run_campaign
-from gcs.campaign.pool import ray_session
-from gcs.campaign.results import (
+from lab.campaign.driver import Outcome, run_campaign
+from lab.campaign.pool import ray_session
+from lab.campaign.results import (
     RESULTS_NAME,
     mission_summary_table,
     read_results,
     summary_table,
 )
-from gcs.campaign.search import BEST_NAME, SearchOutcome, run_search
-from gcs.campaign.spec import BaseMission, Campaign, CampaignError, load_campaign
+from lab.campaign.search import BEST_NAME, SearchOutcome, run_search
+from lab.campaign.spec import BaseMission, Campaign, CampaignError, load_campaign
 
 __all__ = [
     "BEST_NAME",

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from gcs.campaign import CampaignError, load_campaign
-from gcs.campaign.plan import plan_runs
-from gcs.campaign.tables import dumps, read_table
-from gcs.cli import main
 from gcs.config import config_from_table
+from lab.campaign import CampaignError, load_campaign
+from lab.campaign.plan import plan_runs
+from lab.campaign.tables import dumps, read_table
+from lab.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from gcs.campaign.results import mission_summary_table
-from gcs.campaign.run import RunSpec, fly_run, make_run
-from gcs.campaign.spec import BaseFlight
+from lab.campaign.results import mission_summary_table
+from lab.campaign.run import RunSpec, fly_run, make_run
+from lab.campaign.spec import BaseFlight
 from sitl import native
 
 
@@ -58,14 +58,14 @@ class InterruptedRay:
 
 
 def _row(run: object) -> dict:
-    from gcs.campaign.metrics import flown_row
+    from lab.campaign.metrics import flown_row
 
     assert isinstance(run, RunSpec)
     return flown_row(run.run_id, run.values, {"rms_error_m": 0.01, "error_source": "truth"})
 
 
 def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_flies_the_rest(tmp_path: Path) -> None:
-    from gcs.campaign import load_campaign, read_results, run_campaign
+    from lab.campaign import load_campaign, read_results, run_campaign
 
     path = tmp_path / "c.toml"
     path.write_text("[axes]\nseed = { range = [1, 5] }\n", encoding="utf-8")

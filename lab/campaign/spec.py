@@ -53,10 +53,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gcs.campaign.tables import check_faults, check_world, set_dotted, world_table
 from gcs.config import config_from_table
 from gcs.errors import UsageError
 from gcs.flight import FlightPlan
+from lab.campaign.planner_keys import mission_with
+from lab.campaign.tables import check_faults, check_world, set_dotted, world_table
 from worldfile import read_toml
 
 KINDS = ("grid", "random", "search")
@@ -266,10 +267,8 @@ def _mission_base(p: Path, data: dict[str, Any], kind: str) -> BaseMission:
 
 
 def _check_mission(p: Path, key: str, base: BaseMission, planner: dict[str, Any]) -> None:
-    from gcs.campaign.mission_run import mission_with
-
     try:
-        mission_with(base, planner)
+        mission_with(base.mission_path, planner)
     except UsageError as exc:
         raise _fail(p, key, f"{exc}") from None
 
@@ -414,7 +413,7 @@ def _search(p: Path, raw: Any, kind: str, axes: dict[str, Axis]) -> SearchSpec:
             _check_world(p, key, _rel(p, key, w, "world"), {})
         worlds = tuple(worlds_raw)
     objective = raw.get("objective", "rms_error_m")
-    from gcs.campaign.metrics import NUMERIC_METRICS
+    from lab.campaign.metrics import NUMERIC_METRICS
 
     if objective not in NUMERIC_METRICS:
         raise _fail(p, "search.objective", f"expected one of {list(NUMERIC_METRICS)}, got "

@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from gcs.campaign.run import RunSpec, make_run
-from gcs.campaign.spec import Campaign, Range
+from lab.campaign.run import RunSpec, make_run
+from lab.campaign.spec import Campaign, Range
 
 
 def draw(axis: Range | tuple[Any, ...], rng: np.random.Generator) -> Any:
@@ -34,4 +34,4 @@ def plan_runs(c: Campaign) -> list[RunSpec]:
         rng = np.random.default_rng(c.sample_seed)
         return [make_run(c.base, {n: draw(c.axes[n], rng) for n in names})
                 for _ in range(c.samples)]
-    raise ValueError(f"kind {c.kind!r} plans its runs as it goes (gcs.campaign.search)")
+    raise ValueError(f"kind {c.kind!r} plans its runs as it goes (lab.campaign.search)")

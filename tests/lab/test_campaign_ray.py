@@ -18,7 +18,9 @@ pytest.importorskip("optuna", reason="the [campaign] extra is not installed "
 pytest.importorskip("pyarrow", reason="the [campaign] extra is not installed "
                     "(pip install -e '.[campaign]'; make test installs it)")
 
-from gcs.campaign import (
+from gcs.commands.fly import fly
+from gcs.config import load_config
+from lab.campaign import (
     BEST_NAME,
     load_campaign,
     mission_summary_table,
@@ -28,9 +30,7 @@ from gcs.campaign import (
     run_search,
     summary_table,
 )
-from gcs.cli import build_parser
-from gcs.commands.fly import fly
-from gcs.config import load_config
+from lab.cli import build_parser
 from sitl import native
 
 RESULTS = "results.parquet"

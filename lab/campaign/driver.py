@@ -13,14 +13,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from gcs.campaign.metrics import OK
-from gcs.campaign.mission_run import mission_run
-from gcs.campaign.plan import plan_runs
-from gcs.campaign.pool import run_all
-from gcs.campaign.progress import Progress
-from gcs.campaign.results import RESULTS_NAME, read_results, write_results
-from gcs.campaign.run import RunSpec, fly_run
-from gcs.campaign.spec import BaseMission, Campaign
+from lab.campaign.metrics import OK
+from lab.campaign.mission_run import mission_run
+from lab.campaign.plan import plan_runs
+from lab.campaign.pool import run_all
+from lab.campaign.progress import Progress
+from lab.campaign.results import RESULTS_NAME, read_results, write_results
+from lab.campaign.run import RunSpec, fly_run
+from lab.campaign.spec import BaseMission, Campaign
 
 WRITE_EVERY_S = 2.0
 

@@ -22,9 +22,9 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
 
-from gcs.campaign.metrics import failed_row
-from gcs.campaign.run import RunSpec
 from gcs.errors import RuntimeFault, UsageError
+from lab.campaign.metrics import failed_row
+from lab.campaign.run import RunSpec
 
 ADDRESS_ENV = "RAY_ADDRESS"
 CONNECT_TIMEOUT_S = 3.0

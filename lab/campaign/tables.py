@@ -9,14 +9,14 @@ them as they check files. `dumps` writes a station table back as a file `fly --c
 from __future__ import annotations
 
 import copy
-import importlib
 import math
-import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from gcs.foxglove_feed import DEFAULT_WORLD
+from sitl import lockstep as sitl_lockstep
+from worldfile import read_toml
 
 
 def set_dotted(table: dict[str, Any], dotted: str, value: Any) -> dict[str, Any]:
@@ -43,8 +43,8 @@ def merged(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def read_table(path: Path) -> dict[str, Any]:
-    """A TOML file's table."""
-    return tomllib.loads(path.read_text(encoding="utf-8"))
+    """A TOML file's table (TomlFileError, a ValueError of one line, when it cannot be read)."""
+    return read_toml(path)
 
 
 def world_table(world: Path | None, over: Mapping[str, Any]) -> dict[str, Any]:
@@ -54,12 +54,12 @@ def world_table(world: Path | None, over: Mapping[str, Any]) -> dict[str, Any]:
 
 def check_world(table: Mapping[str, Any]) -> None:
     """Let the SITL's world loader judge a table (ValueError, one line, when it refuses)."""
-    importlib.import_module("sitl.lockstep").world_of(table)
+    sitl_lockstep.world_of(table)
 
 
 def check_faults(faults: Mapping[str, Any]) -> None:
     """Let the SITL judge a link-fault table (ValueError or TypeError, one line)."""
-    importlib.import_module("sitl.lockstep").LinkFaults(**faults)
+    sitl_lockstep.LinkFaults(**faults)
 
 
 def station_table(config: Path | None, over: Mapping[str, Any]) -> dict[str, Any]:

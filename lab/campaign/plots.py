@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from gcs.campaign.metrics import OK
+from lab.campaign.metrics import OK
 
 
 def _pyplot() -> Any:

@@ -1,0 +1,1 @@
+"""What needs the station and the simulator in one process: lockstep flights, campaigns."""
