@@ -13,7 +13,8 @@ import time
 from collections.abc import Callable
 
 from firmware_link.records import FlightMode
-from gcs.control.position_controller import PositionSetpoint, yaw_from_quat
+from gcs.control.attitude import yaw_from_quat
+from gcs.control.position_controller import PositionSetpoint
 from gcs.errors import FlightFailed
 from gcs.flight_plan import PHASE_STATES, FlightPlan, FlightSample, FlightSummary, Phase
 from gcs.launch import Launch, LaunchRules, LaunchStage, vehicle_said

@@ -13,7 +13,8 @@ import math
 from dataclasses import dataclass
 
 from gcs.config import StationConfig
-from gcs.control.position_controller import PositionSetpoint, yaw_from_quat
+from gcs.control.attitude import yaw_from_quat
+from gcs.control.position_controller import PositionSetpoint
 from gcs.flight import FlightPlan, FlightRunner
 from gcs.lockstep_session import LockstepSession
 from gcs.station.session import SessionOptions

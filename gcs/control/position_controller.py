@@ -37,7 +37,9 @@ from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
-from firmware_link.records import MocapPose, Quat, RcCommand
+from firmware_link.records import MocapPose, RcCommand
+from gcs.control.attitude import lean_accel, roll_pitch_from_quat, wrap_pi, yaw_from_quat
+from gcs.control.axis_filters import AlphaBeta, SetpointProfile
 from gcs.estimation import GRAVITY_MPS2
 
 
@@ -167,92 +169,6 @@ class PositionCommand:
     lean_offset_pitch_rad: float = 0.0  # true lean - the vehicle's estimate, as subtracted
     lean_offset_roll_rad: float = 0.0
     saturated: bool = False  # the lean limit cut the asked acceleration
-
-
-def yaw_from_quat(q_nb: Quat) -> float:
-    """Heading (rad) of a body→NED quaternion (w, x, y, z), ZYX convention."""
-    w, x, y, z = q_nb
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-def roll_pitch_from_quat(q_nb: Quat) -> tuple[float, float]:
-    """Roll and pitch (rad) of a body→NED quaternion (w, x, y, z), ZYX convention."""
-    w, x, y, z = q_nb
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    return roll, pitch
-
-
-def wrap_pi(a: float) -> float:
-    """Angle wrapped to [-π, π)."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-class SetpointProfile:
-    """Trapezoidal velocity profile towards a target that may move at any time (one axis).
-
-    The rate approaches min(cruise, √(2·a·distance)) by at most a·dt per step, so it brakes in
-    time to stop at the target; the last step lands on it."""
-
-    def __init__(self, speed_mps: float, accel_mps2: float, pos_m: float) -> None:
-        self.speed = speed_mps
-        self.accel = accel_mps2
-        self.pos_m = pos_m
-        self.vel_mps = 0.0
-
-    def step(self, target_m: float, dt_s: float) -> None:
-        """Advance by `dt_s`."""
-        dist = target_m - self.pos_m
-        want = math.copysign(min(self.speed, math.sqrt(2.0 * self.accel * abs(dist))), dist)
-        dv = self.accel * dt_s
-        vel = self.vel_mps + min(max(want - self.vel_mps, -dv), dv)
-        move = vel * dt_s
-        if abs(move) >= abs(dist) and move * dist >= 0.0:
-            move, vel = dist, 0.0  # arrives within this step
-        self.pos_m += move
-        self.vel_mps = vel
-
-
-class AlphaBeta:
-    """Position and velocity from position fixes and the acceleration between them (one axis).
-
-    A critically damped alpha-beta observer whose gains follow each fix's interval, corner
-    `hz`, propagated with the measured acceleration: the velocity then needs no differencing
-    and does not lag. Without the acceleration (0) it lags a ramp by 1/(π·hz) s: at 3 Hz,
-    0.1 s, which with the lean's own lag left the brake on after a 0.5 m leg and swung the
-    vehicle back 7 cm. With it, against the SITL's truth: 1.4 cm/s RMS holding, 1.5 during a
-    leg (motion capture's 2 mm and 0.2° noise, 3 Hz)."""
-
-    def __init__(self, hz: float, pos_m: float) -> None:
-        self.omega = 2.0 * math.pi * hz
-        self.pos_m = pos_m
-        self.vel_mps = 0.0
-        self.acc_mps2 = 0.0
-
-    def fix(self, pos_m: float, dt_s: float, acc_mps2: float = 0.0) -> None:
-        """A new fix `dt_s` after the last; `acc_mps2` the acceleration measured with it."""
-        theta = math.exp(-self.omega * dt_s)
-        alpha, beta = 1.0 - theta * theta, (1.0 - theta) ** 2
-        acc = 0.5 * (self.acc_mps2 + acc_mps2)  # over the interval: the mean of its two ends
-        predicted = self.pos_m + self.vel_mps * dt_s + 0.5 * acc * dt_s * dt_s
-        residual = pos_m - predicted
-        self.pos_m = predicted + alpha * residual
-        self.vel_mps += acc * dt_s + beta / dt_s * residual
-        self.acc_mps2 = acc_mps2
-
-    def restart(self, pos_m: float) -> None:
-        """Start again at `pos_m`, at rest (after a gap in the fixes)."""
-        self.pos_m, self.vel_mps, self.acc_mps2 = pos_m, 0.0, 0.0
-
-
-def lean_accel(q_nb: Quat) -> tuple[float, float]:
-    """Horizontal acceleration (north, east, m/s²) of a vehicle leaning as `q_nb` while its
-    thrust carries its weight (altitude held): the thrust along -z body, its vertical part g.
-    Rotor and body drag (under 0.1 m/s² at 1 m/s) are left to the observer's correction."""
-    w, x, y, z = q_nb
-    zx, zy = 2.0 * (x * z + w * y), 2.0 * (y * z - w * x)  # body z axis in NED
-    zz = max(1.0 - 2.0 * (x * x + y * y), 0.5)  # never beyond 60° of tilt
-    return -GRAVITY_MPS2 * zx / zz, -GRAVITY_MPS2 * zy / zz
 
 
 class _Axis:

@@ -25,18 +25,12 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
-from firmware_link.errors import LinkUsageError
 from firmware_link.records import (
-    Attitude,
     CommandAck,
     Dialect,
     Heartbeat,
-    Imu,
     LinkEvent,
     LinkEventKind,
-    MocapPose,
-    Rangefinder,
-    SimTruth,
     StatusText,
     TelemetryRecord,
 )
@@ -48,10 +42,12 @@ from gcs.core import FlightCore, TickInputs
 from gcs.core.inputs import NEVER_S
 from gcs.core.landing import may_leave, must_land
 from gcs.estimation import AltEstimator
+from gcs.station.execute import send_decision
 from gcs.station.exit import emergency_land, let_go
 from gcs.station.intents import STICK_MAX_US, STICK_MIN_US, StationIntents
 from gcs.station.loop import FixedRateLoop
 from gcs.station.record import record_tick
+from gcs.station.snapshot import make_snapshot
 from gcs.station.types import (
     ControlMode,
     EventLevel,
@@ -64,15 +60,11 @@ from gcs.station.types import (
     control_mode,
 )
 from gcs.supervisor import (
-    ActionKind,
     Intent,
     IntentKind,
-    LinkHealth,
     Outcome,
     Supervisor,
-    SupervisorOutput,
     SupervisorParams,
-    SupervisorState,
     VehicleStatus,
 )
 
@@ -324,7 +316,10 @@ class Station(StationIntents):
         self._ingest(records)
         inputs = TickInputs.of(k, t_s, dt_s, self._vehicle_status(t_s), records, intents)
         out = self.core.step(inputs)
-        self._execute(t_s, out.supervisor)
+        self._heartbeats_on = send_decision(self.link, out.supervisor, self._heartbeats_on)
+        for note in out.supervisor.notes:
+            self._event(t_s, EventLevel(int(note.level)), note.text)
+        self._outcomes.extend(out.supervisor.outcomes)
         if self.recorder is not None:
             record_tick(self.recorder, inputs, out, self.loop.last_timing)
         snap = self._make_snapshot(t_s, k)
@@ -347,33 +342,6 @@ class Station(StationIntents):
             seen=hb is not None, armed=bool(hb and hb.armed), mode=hb.mode if hb else -1,
             heartbeat_t_s=hb.t_s if hb else -NEVER_S,
             frame_age_s=min(NEVER_S, t_s - self._last_rx_s))
-
-    def _execute(self, t_s: float, out: SupervisorOutput) -> None:
-        link = self.link
-        for a in out.actions:
-            if a.kind is ActionKind.ARM:
-                link.send_arm(False)
-            elif a.kind is ActionKind.DISARM:
-                link.send_disarm(False)
-            elif a.kind is ActionKind.FORCE_DISARM:
-                try:
-                    link.send_disarm(True)
-                except LinkUsageError:  # the firmware turned out to have no force
-                    link.send_disarm(False)
-            elif a.kind is ActionKind.SET_MODE:
-                link.send_set_mode(a.mode)
-            elif a.kind is ActionKind.RELEASE:
-                link.release_overrides()
-        if out.heartbeat != self._heartbeats_on:
-            self._heartbeats_on = out.heartbeat
-            set_hb = getattr(link, "set_gcs_heartbeat", None)
-            if set_hb is not None:
-                set_hb(out.heartbeat)
-        if out.command is not None:
-            link.rc_override(out.command)
-        for note in out.notes:
-            self._event(t_s, EventLevel(int(note.level)), note.text)
-        self._outcomes.extend(out.outcomes)
 
     def _ingest(self, records: list[TelemetryRecord]) -> None:
         """Keep the newest of each record type, hand each to the record listeners, record it,
@@ -403,50 +371,8 @@ class Station(StationIntents):
                             f"vehicle: {r.text}")
 
     def _make_snapshot(self, t_s: float, k: int) -> StationSnapshot:
-        sup = self.core.supervisor
-        latest = dict(self._latest)
-        hb = latest.get(Heartbeat)
-        hb = hb if isinstance(hb, Heartbeat) else None
-        last = self.core.last
-        out = last.supervisor if last is not None else None
-        estimate = last.estimate if last is not None else None
-
-        def get(cls: type) -> Any:
-            r = latest.get(cls)
-            return r if isinstance(r, cls) else None
-
-        return StationSnapshot(
-            t_s=t_s,
-            tick=k,
-            running=self._running,
-            mode=control_mode(sup.state, sup.pos_setpoint is not None),
-            state=sup.state,
-            link_health=out.link if out is not None else LinkHealth.OK,
-            armed=bool(hb and hb.armed),
-            vehicle_mode=hb.mode if hb else -1,
-            link_lost=out is not None and out.link is LinkHealth.LOST,
-            heartbeat=hb,
-            attitude=get(Attitude),
-            imu=get(Imu),
-            rangefinder=get(Rangefinder),
-            mocap=get(MocapPose),
-            truth=get(SimTruth),
-            latest=latest,
-            estimate=estimate,
-            alt_setpoint_m=out.alt_setpoint_m if out is not None else None,
-            position_setpoint=sup.pos_setpoint if sup.state is SupervisorState.HOLD else None,
-            alt=sup.alt,
-            position=sup.position,
-            command=sup.command,
-            sticks=sup.sticks,
-            throttle_gate_us=out.throttle_gate_us if out is not None else None,
-            hover_throttle=self.core.alt_ctrl.hover_throttle,
-            loop=self._empty_stats if k < 0 else self._snapshot.loop,
-            link_stats=self.link.stats,
-            events=tuple(self._events),
-            listener_errors=self._listener_errors,
-            link_down_s=last.link_down_s if last is not None else 0.0,
-            safe_throttle_us=(sup.safe_throttle_us(estimate.alt_m)
-                              if estimate is not None else STICK_MIN_US),
-            outcomes=tuple(self._outcomes),
-        )
+        return make_snapshot(
+            t_s, k, running=self._running, core=self.core, latest=self._latest,
+            loop=self._empty_stats if k < 0 else self._snapshot.loop, link_stats=self.link.stats,
+            events=tuple(self._events), listener_errors=self._listener_errors,
+            outcomes=tuple(self._outcomes))

@@ -12,12 +12,8 @@ import pytest
 from firmware_link.records import Dialect, MocapPose
 from gcs.config import EstimatorKind, StationConfig, load_config
 from gcs.control.altitude_controller import AltitudeController, AltitudeControllerParams
-from gcs.control.position_controller import (
-    PositionController,
-    PositionSetpoint,
-    wrap_pi,
-    yaw_from_quat,
-)
+from gcs.control.attitude import wrap_pi, yaw_from_quat
+from gcs.control.position_controller import PositionController, PositionSetpoint
 from gcs.control.throttle_curve import CurveKind, ThrottleCurve
 from gcs.errors import UsageError
 from gcs.estimation import GRAVITY_MPS2, AltEstimate, SonarStatus

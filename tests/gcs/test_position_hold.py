@@ -15,13 +15,9 @@ from collections import deque
 import pytest
 
 from firmware_link.records import MocapPose
-from gcs.control.position_controller import (
-    AlphaBeta,
-    PositionController,
-    PositionSetpoint,
-    SetpointProfile,
-    lean_accel,
-)
+from gcs.control.attitude import lean_accel
+from gcs.control.axis_filters import AlphaBeta, SetpointProfile
+from gcs.control.position_controller import PositionController, PositionSetpoint
 from gcs.estimation import GRAVITY_MPS2
 
 DT = 0.025
