@@ -23,15 +23,10 @@ import time
 
 import numpy as np
 
+from gcs.mission.kinematic_flock import FlockResult, fly_flock_scene
 from planners.flocking.planner import FlockParams, FollowerPolicy
 from planners.flocking.scenes import all_scenes
-from planners.flocking.sim import (
-    FlockResult,
-    PlannerFactory,
-    reynolds_factory,
-    run_flock,
-    triangular_factory,
-)
+from planners.flocking.swarm import PlannerFactory, reynolds_factory, triangular_factory
 
 MAX_STEPS = 1200
 SEED = 7
@@ -75,7 +70,7 @@ def main(argv: list[str]) -> None:
             totals: dict[str, FlockResult] = {}
             for label, factory in planners:
                 t0 = time.perf_counter()
-                r = run_flock(scene, n, factory, MAX_STEPS, np.random.default_rng(SEED))
+                r = fly_flock_scene(scene, n, factory, MAX_STEPS, np.random.default_rng(SEED))
                 print(_row(label, r, time.perf_counter() - t0), flush=True)
                 totals[label] = r
             tri, rey = totals["triangular"], totals["reynolds"]

@@ -23,24 +23,25 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from planners.epbha.run import run_epbha
+from gcs.mission.kinematic_runs import EpbhaRun, fly_epbha_scene
 from planners.kinematic import KinematicParams
 from planners.proximity import ProximityParams
-from planners.result import PlanResult
 from planners.scenes import Scene, random_room, thesis_scenes
 from planners.search.astar import plan_astar
 from planners.search.dstar_lite import run_dstar_lite
+from planners.search.result import SearchResult
 
 MAX_STEPS = 3000
 BODY_RADIUS_M = KinematicParams().body_radius_m
-PLANNERS: dict[str, Callable[[Scene], PlanResult]] = {
-    "EPBHA": lambda s: run_epbha(s.world, s.start_n, s.goal_n, max_steps=MAX_STEPS),
+Result = EpbhaRun | SearchResult
+PLANNERS: dict[str, Callable[[Scene], Result]] = {
+    "EPBHA": lambda s: fly_epbha_scene(s.world, s.start_n, s.goal_n, max_steps=MAX_STEPS),
     "A*": lambda s: plan_astar(s.world, s.start_n, s.goal_n),
     "D* Lite": lambda s: run_dstar_lite(s.world, s.start_n, s.goal_n, max_steps=MAX_STEPS),
 }
 
 
-def run_all(scene: Scene) -> dict[str, PlanResult]:
+def run_all(scene: Scene) -> dict[str, Result]:
     """Every planner on one scene."""
     return {name: plan(scene) for name, plan in PLANNERS.items()}
 
@@ -95,7 +96,7 @@ def noisy_thesis(seeds: int) -> None:
     print(f"EPBHA with 1 cm IR noise (sigma), {seeds} seeds per scene")
     for scene in thesis_scenes():
         runs = [
-            run_epbha(scene.world, scene.start_n, scene.goal_n, max_steps=MAX_STEPS,
+            fly_epbha_scene(scene.world, scene.start_n, scene.goal_n, max_steps=MAX_STEPS,
                       proximity=params, rng=np.random.default_rng(seed))
             for seed in range(seeds)
         ]
@@ -111,7 +112,7 @@ def noisy_thesis(seeds: int) -> None:
 def random_summary(rooms: int, seed: int) -> None:
     """Print success rate, length ratio, effort and EPBHA's failure breakdown over random rooms."""
     rng = np.random.default_rng(seed)
-    per: dict[str, list[PlanResult]] = {name: [] for name in PLANNERS}
+    per: dict[str, list[Result]] = {name: [] for name in PLANNERS}
     ratios: dict[str, list[float]] = {name: [] for name in PLANNERS}
     breakdown: collections.Counter[str] = collections.Counter()
     unreachable = 0

@@ -30,11 +30,8 @@ sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
 
 import numpy as np  # noqa: E402
 
-from planners.radiation import (  # noqa: E402
-    RadiationMapperParams,
-    RadiationResult,
-    run_radiation,
-)
+from gcs.mission.kinematic_runs import fly_radiation_field  # noqa: E402
+from planners.radiation import RadiationMapperParams, RadiationResult  # noqa: E402
 from planners.radiation.field import RadiationField  # noqa: E402
 from planners.radiation.lawnmower import Interpolation, run_lawnmower  # noqa: E402
 
@@ -120,7 +117,7 @@ def main() -> None:
         field = random_field(master, n_src)
         seed = int(master.integers(1 << 31))
         t0 = time.process_time()
-        ours = run_radiation(field, params, np.random.default_rng(seed), args.max_samples)
+        ours = fly_radiation_field(field, params, np.random.default_rng(seed), args.max_samples)
         cpu = time.process_time() - t0
         results = sweep(field, ours.level_cps, seed + 1, params)
         match = first_reaching(results, ours.iou)

@@ -22,7 +22,7 @@ from gcs.mission.port import Count
 from gcs.mission.recording import MissionRecording
 from gcs.mission.report import RunMode
 from gcs.mission.spec import MissionSpec
-from planners.flocking.sim import FlockRunParams, pairwise_min_m
+from planners.flocking.separation import VEHICLE_COLLISION_M, pairwise_min_m
 from planners.geometry import Vec3
 from planners.kinematic import KinematicSim
 from planners.proximity import ProximityReading
@@ -39,7 +39,7 @@ class KinematicPort:
                  t0_s: float, *, step_s: float | None = None, speed_mps: float = 1.0,
                  field: RadiationField | None = None, rng: np.random.Generator | None = None,
                  progress: Callable[[str], None] | None = None,
-                 vehicle_collision_m: float = FlockRunParams().vehicle_collision_m) -> None:
+                 vehicle_collision_m: float = VEHICLE_COLLISION_M) -> None:
         self.spec = spec
         self.rec = rec
         self.sims = sims

@@ -19,6 +19,7 @@ from gcs.mission.port import ObstaclePort
 from gcs.mission.recording import STEP_FLOCK, flock_payload
 from gcs.mission.report import MissionStatus
 from planners.flocking.planner import FlockMission, FlockPlanner
+from planners.flocking.swarm import SwarmPlanner
 from planners.geometry import Vec3
 
 LOOP = "flock"
@@ -35,16 +36,19 @@ class _Tally:
     time_to_goal: dict[int, float | None] = field(default_factory=dict)
 
 
-def fly_flock(port: ObstaclePort, setup: PlannerSetup, start_n: dict[int, Vec3]) -> Outcome:
-    """Fly the port's vehicles (the root leader first) from `start_n` to the mission's goals."""
+def fly_flock(port: ObstaclePort, setup: PlannerSetup, start_n: dict[int, Vec3],
+              planner: SwarmPlanner | None = None) -> Outcome:
+    """Fly the port's vehicles (the root leader first) from `start_n` to the mission's goals
+    with `planner`, by default the triangular flock the mission and its setup describe."""
     spec = port.spec
     ids = list(port.vehicles())
-    goal = spec.goal_n
-    assert goal is not None
-    individual = {ids[k]: g for k, g in enumerate(spec.goals_n[1:]) if k < len(ids)}
-    lead = start_n[ids[0]]
-    heading = (goal[0] - lead[0], goal[1] - lead[1])
-    planner = FlockPlanner(ids, FlockMission(goal, individual), heading, setup.params)
+    if planner is None:
+        goal = spec.goal_n
+        assert goal is not None
+        individual = {ids[k]: g for k, g in enumerate(spec.goals_n[1:]) if k < len(ids)}
+        lead = start_n[ids[0]]
+        heading = (goal[0] - lead[0], goal[1] - lead[1])
+        planner = FlockPlanner(ids, FlockMission(goal, individual), heading, setup.params)
     pos = {v: start_n[v] for v in ids}
     paths = {v: [start_n[v]] for v in ids}
     tally = _Tally(time_to_goal=dict.fromkeys(ids))

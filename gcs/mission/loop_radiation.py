@@ -42,14 +42,16 @@ def count_time_s(cps: float, p: RadiationMapperParams) -> float:
 
 
 def fly_radiation(port: DetectorPort, setup: PlannerSetup, start_n: Vec3,
-                  truth: RadiationField | None) -> Outcome:
+                  truth: RadiationField | None, mapper: RadiationMapper | None = None) -> Outcome:
     """Map the floor from `start_n`; score the map against `truth` when the run may know it
-    (else None)."""
+    (else None). A `mapper` given is the one flown (its caller reads its state afterwards),
+    else one is made from the setup."""
     spec = port.spec
     v = port.vehicles()[0]
     p = setup.params
     alt = spec.takeoff_alt_m
-    mapper = RadiationMapper(p, max_samples=setup.max_samples)
+    if mapper is None:
+        mapper = RadiationMapper(p, max_samples=setup.max_samples)
     here = p.clip(np.asarray(start_n[:2], dtype=float))
     target: Vec3 = (float(here[0]), float(here[1]), -alt)
     port.go({v: target}, timeout_s=spec.step_timeout_s + math.dist(start_n, target) / TRAVEL_MPS)

@@ -65,8 +65,9 @@ Where this code departs from the text, and why:
   the two readings place the nearest such edge, and a move must pass it by
   `wedge_clearance_m` (:mod:`planners.epbha.wedges`).
 
-`run_epbha` (:mod:`planners.epbha.run`) flies the planner in the kinematic world, whose cones
-report the nearest surface anywhere inside them, as the memory takes a reading to mean.
+The missions' loop (`gcs.mission.loop_epbha`) flies the planner, in the kinematic world too,
+whose cones report the nearest surface anywhere inside them, as the memory takes a reading to
+mean.
 """
 
 from __future__ import annotations

@@ -16,8 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planners.flocking.formation import Formation, FormationParams, rotate_f_to_n
+from planners.flocking.formation import Formation, FormationParams, role_of, rotate_f_to_n
 from planners.flocking.planner import FlockMission
+from planners.flocking.types import FlockStep, Phase, VehicleMode
 from planners.geometry import Vec3
 from planners.proximity import AXIS_B, Facing, ProximityReading
 
@@ -41,16 +42,6 @@ class ReynoldsParams:
     def __post_init__(self) -> None:
         if self.max_step_m <= 0.0:
             raise ValueError(f"max_step_m must be > 0, got {self.max_step_m}")
-
-
-@dataclass(frozen=True, slots=True)
-class ReynoldsStep:
-    """One step of the baseline."""
-
-    setpoints_n: dict[int, Vec3]
-    messages_sent: int
-    formation_samples: tuple[float, ...] = ()
-    state_reads: int = 0  # every teammate's state already arrives in the N·(N−1) messages
 
 
 class ReynoldsPlanner:
@@ -114,8 +105,10 @@ class ReynoldsPlanner:
         step_index: int,
         positions_n: dict[int, Vec3],
         readings: dict[int, ProximityReading],
-    ) -> ReynoldsStep:
-        """One Reynolds update for every vehicle."""
+    ) -> FlockStep:
+        """One Reynolds update for every vehicle, in the flock's step type: each vehicle's
+        role is its formation slot's (the baseline starts from and ends on the same slots),
+        every teammate's state already arrives in the N·(N−1) messages (no further reads)."""
         prm = self.params
         pos = {v: np.asarray(positions_n[v], dtype=float) for v in self.ids}
         vel = {
@@ -161,8 +154,16 @@ class ReynoldsPlanner:
             norm = float(np.linalg.norm(steer))
             step = min(prm.max_step_m, dist)
             new = p + (steer / norm * step if norm > 1e-9 else np.zeros(3))
-            self._arrived[v] = float(np.linalg.norm(self._targets[v] - new)) <= prm.goal_tolerance_m
+            # judged where the vehicle is, not where it is sent: the mission loop flies no plan
+            # after the one that finds every vehicle arrived
+            self._arrived[v] = dist <= prm.goal_tolerance_m
             out[v] = (float(new[0]), float(new[1]), float(new[2]))
         self._prev = pos
         n = len(self.ids)
-        return ReynoldsStep(setpoints_n=out, messages_sent=n * (n - 1))
+        return FlockStep(
+            setpoints_n=out, messages_sent=n * (n - 1),
+            modes={v: VehicleMode.ARRIVED if self._arrived[v] else VehicleMode.FORMATION
+                   for v in self.ids},
+            roles={v: role_of(k, n) for k, v in enumerate(self.ids)},
+            phase=Phase.COMMON_GOAL, formation_error_m=None, formation_samples=(),
+            leader_avoiding=False, held_by_guard=())

@@ -4,13 +4,14 @@ The concepts live in their own modules: parameters and phases (``params``), what
 out (``types``), its evidence model (``evidence``: a Gaussian process, ``gp``, and contours,
 ``contour``), the sampling plan (``mapper``, whose docstring tells the algorithm and its departures
 from the text, with its flight budget, ``budget``, and visit order, ``tsp``), the analytic field
-(``field``), scoring against the truth (``score``), a kinematic run (``run``) and the lawnmower
-baseline (``lawnmower``).
+(``field``), scoring against the truth (``score``), a detector reading (``reading``) and the
+lawnmower baseline (``lawnmower``). The mapper is flown, in the kinematic world too, by the
+missions' loop (``gcs.mission.loop_radiation``).
 """
 
 from planners.radiation.mapper import RadiationMapper, fan_points, sampling_distance_m
 from planners.radiation.params import Phase, RadiationMapperParams, Status
-from planners.radiation.run import run_radiation, take_reading
+from planners.radiation.reading import take_reading
 from planners.radiation.score import Evaluation, evaluate_region
 from planners.radiation.types import Decision, Hotspot, Layer, MapEstimate, RadiationResult
 
@@ -27,7 +28,6 @@ __all__ = [
     "Status",
     "evaluate_region",
     "fan_points",
-    "run_radiation",
     "sampling_distance_m",
     "take_reading",
 ]

@@ -14,8 +14,8 @@ from collections.abc import Callable
 
 from planners.geometry import Vec3, World, as_vec3
 from planners.kinematic import KinematicParams, KinematicSim
-from planners.result import PlanResult, PlanStatus
 from planners.search.grid import DIRECTIONS, Grid, GridParams
+from planners.search.result import SearchResult, SearchStatus
 
 
 def astar_search(grid: Grid, start: int, goal: int) -> tuple[list[int] | None, int, int]:
@@ -70,7 +70,7 @@ def plan_astar(
     goal_n: Vec3,
     grid_params: GridParams | None = None,
     cpu_clock: Callable[[], float] = time.process_time,
-) -> PlanResult:
+) -> SearchResult:
     """Plan on the fully known map and fly the plan in the kinematic world.
 
     The plan is one step: its CPU time includes building the occupancy grid.
@@ -79,18 +79,19 @@ def plan_astar(
     grid = Grid(world, start_n, grid_params)
     start, goal = grid.nearest(start_n), grid.nearest(goal_n)
     if start is None or goal is None or not grid.is_free(start) or not grid.is_free(goal):
-        return PlanResult("A*", PlanStatus.START_BLOCKED, (as_vec3(start_n),), 0, 0,
+        return SearchResult("A*", SearchStatus.START_BLOCKED, (as_vec3(start_n),), 0, 0,
                           (cpu_clock() - t0,), world.clearance(start_n), 0,
                           "start or goal is within the body radius of an obstacle or wall")
     nodes, expansions, evaluations = astar_search(grid, start, goal)
     cpu = cpu_clock() - t0
     if nodes is None:
-        return PlanResult("A*", PlanStatus.GOAL_UNREACHABLE, (grid.point(start),), evaluations,
+        return SearchResult("A*", SearchStatus.GOAL_UNREACHABLE, (grid.point(start),), evaluations,
                           expansions, (cpu,), world.clearance(grid.point(start)), 0,
                           "no free grid path to the goal")
     sim = KinematicSim(world, grid.point(start),
                        KinematicParams(body_radius_m=grid.params.body_radius_m))
     for u in nodes[1:]:
         sim.move_to(grid.point(u))
-    return PlanResult("A*", PlanStatus.REACHED, tuple(sim.path), evaluations, expansions, (cpu,),
-                      sim.min_clearance_m, sim.collisions, penetrations=sim.penetrations)
+    return SearchResult("A*", SearchStatus.REACHED, tuple(sim.path), evaluations, expansions,
+                        (cpu,), sim.min_clearance_m, sim.collisions,
+                        penetrations=sim.penetrations)

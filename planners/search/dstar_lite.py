@@ -19,8 +19,8 @@ import numpy as np
 
 from planners.geometry import Vec3, World, as_vec3
 from planners.kinematic import KinematicParams, KinematicSim
-from planners.result import PlanResult, PlanStatus
 from planners.search.grid import DIRECTIONS, Grid, GridParams
+from planners.search.result import SearchResult, SearchStatus
 
 INF = math.inf
 Key = tuple[float, float]
@@ -195,12 +195,12 @@ def run_dstar_lite(
     sensor_range_m: float = 0.5,
     max_steps: int = 5000,
     cpu_clock: Callable[[], float] = time.process_time,
-) -> PlanResult:
+) -> SearchResult:
     """Fly D* Lite through the kinematic world, discovering obstacles within sensor range."""
     grid = Grid(world, start_n, grid_params)
     start, goal = grid.nearest(start_n), grid.nearest(goal_n)
     if start is None or goal is None or not grid.is_free(start):
-        return PlanResult("D* Lite", PlanStatus.START_BLOCKED, (as_vec3(start_n),), 0, 0, (),
+        return SearchResult("D* Lite", SearchStatus.START_BLOCKED, (as_vec3(start_n),), 0, 0, (),
                           world.clearance(start_n), 0,
                           "start is within the body radius of an obstacle or wall")
     sim = KinematicSim(world, grid.point(start),
@@ -211,16 +211,16 @@ def run_dstar_lite(
     planner.block_edges(_sense(grid, planner, start, sensor_range_m))
     planner.compute_shortest_path()
     cpu.append(cpu_clock() - t0)
-    status, detail = PlanStatus.MAX_STEPS, f"no goal after {max_steps} steps"
+    status, detail = SearchStatus.MAX_STEPS, f"no goal after {max_steps} steps"
     for _ in range(max_steps):
         if planner.start == goal:
-            status, detail = PlanStatus.REACHED, ""
+            status, detail = SearchStatus.REACHED, ""
             break
         t0 = cpu_clock()
         nxt = planner.next_node() if planner.rhs.get(planner.start, INF) < INF else None
         if nxt is None:
             cpu.append(cpu_clock() - t0)
-            status, detail = PlanStatus.GOAL_UNREACHABLE, "no path to the goal on the sensed map"
+            status, detail = SearchStatus.GOAL_UNREACHABLE, "no path to the goal on the sensed map"
             break
         planner.move_to(nxt)
         planner.block_edges(_sense(grid, planner, nxt, sensor_range_m))
@@ -228,6 +228,6 @@ def run_dstar_lite(
         planner.compute_shortest_path()
         cpu.append(cpu_clock() - t0)
         sim.move_to(grid.point(nxt))
-    return PlanResult("D* Lite", status, tuple(sim.path), planner.evaluations,
+    return SearchResult("D* Lite", status, tuple(sim.path), planner.evaluations,
                       planner.expansions, tuple(cpu), sim.min_clearance_m, sim.collisions,
                       detail, sim.penetrations)

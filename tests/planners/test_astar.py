@@ -5,9 +5,9 @@ from collections import deque
 import pytest
 
 from planners.geometry import Box, World
-from planners.result import PlanStatus
 from planners.search.astar import astar_search, plan_astar
 from planners.search.grid import DIRECTIONS, Grid, GridParams
+from planners.search.result import SearchStatus
 
 ROOM = Box("room", (0.0, 0.0, -1.2), (2.0, 2.0, 0.0))
 
@@ -74,7 +74,7 @@ def test_astar_path_is_optimal_against_bfs(seed: int) -> None:
 def test_plan_astar_reports_reached_path_without_collisions() -> None:
     world = World(ROOM, (Box("cube", (0.8, 0.0, -1.2), (1.2, 1.5, 0.0)),))
     r = plan_astar(world, (0.3, 0.5, -0.6), (1.7, 0.5, -0.6))
-    assert r.status is PlanStatus.REACHED and r.collisions == 0
+    assert r.status is SearchStatus.REACHED and r.collisions == 0
     assert r.path[0] == pytest.approx((0.3, 0.5, -0.6))
     assert r.path[-1] == pytest.approx((1.7, 0.5, -0.6))
     assert r.min_clearance_m >= 0.15
@@ -84,11 +84,11 @@ def test_plan_astar_reports_reached_path_without_collisions() -> None:
 def test_unreachable_goal_gives_no_fake_path() -> None:
     wall = Box("wall", (0.95, 0.0, -1.2), (1.05, 2.0, 0.0))
     r = plan_astar(World(ROOM, (wall,)), (0.3, 0.5, -0.6), (1.7, 0.5, -0.6))
-    assert r.status is PlanStatus.GOAL_UNREACHABLE and not r.reached
+    assert r.status is SearchStatus.GOAL_UNREACHABLE and not r.reached
     assert len(r.path) == 1 and r.node_expansions > 0
 
 
 def test_start_inside_an_obstacle_is_reported() -> None:
     cube = Box("cube", (0.2, 0.2, -1.0), (0.6, 0.6, 0.0))
     r = plan_astar(World(ROOM, (cube,)), (0.4, 0.4, -0.5), (1.7, 0.5, -0.6))
-    assert r.status is PlanStatus.START_BLOCKED and "radius" in r.detail
+    assert r.status is SearchStatus.START_BLOCKED and "radius" in r.detail

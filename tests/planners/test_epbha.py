@@ -4,6 +4,8 @@ import math
 
 import pytest
 
+from gcs.mission.kinematic_runs import START_BLOCKED, fly_epbha_scene
+from gcs.mission.report import MissionStatus
 from planners.epbha.planner import (
     Epbha,
     EpbhaParams,
@@ -13,9 +15,7 @@ from planners.epbha.planner import (
     Reason,
     Status,
 )
-from planners.epbha.run import run_epbha
 from planners.proximity import Facing, ProximityReading
-from planners.result import PlanStatus
 from planners.scenes import Scene, thesis_scenes
 
 START = (0.0, 0.0, -1.0)
@@ -181,8 +181,8 @@ def test_revisiting_a_cell_too_often_is_a_loop_deadlock() -> None:
 
 @pytest.mark.parametrize("scene", thesis_scenes(), ids=lambda s: s.name)
 def test_thesis_scenes_are_reached_without_collisions(scene: Scene) -> None:
-    r = run_epbha(scene.world, scene.start_n, scene.goal_n, max_steps=1500)
-    assert r.status is PlanStatus.REACHED, r.detail
+    r = fly_epbha_scene(scene.world, scene.start_n, scene.goal_n, max_steps=1500)
+    assert r.reached, r.detail
     assert r.collisions == 0 and r.min_clearance_m >= 0.15
     assert math.dist(r.path[-1], scene.goal_n) <= 0.1
     assert r.cost_evaluations <= 4 * r.steps
@@ -230,7 +230,7 @@ def test_pass_along_reaches_the_face_that_blocked_the_way() -> None:
     assert descended * 0.1 >= 0.3 + 0.17 - 1e-9
 
 
-def test_run_epbha_reports_a_deadlock_in_a_closed_cell() -> None:
+def test_the_epbha_loop_reports_a_deadlock_in_a_closed_cell() -> None:
     from planners.geometry import Box, World
 
     room = Box("room", (0.0, 0.0, -2.0), (3.0, 3.0, 0.0))
@@ -241,15 +241,15 @@ def test_run_epbha_reports_a_deadlock_in_a_closed_cell() -> None:
         Box("w", (1.2, 1.2, -2.0), (1.8, 1.3, 0.0)),
         Box("lid", (1.2, 1.2, -1.8), (1.8, 1.8, -1.7)),
     ))
-    r = run_epbha(cell, (1.5, 1.5, -1.0), (2.5, 1.5, -1.0), max_steps=500)
-    assert r.status is PlanStatus.DEADLOCK and r.detail.startswith("deadlock")
+    r = fly_epbha_scene(cell, (1.5, 1.5, -1.0), (2.5, 1.5, -1.0), max_steps=500)
+    assert r.status is MissionStatus.FAILED and r.reason.startswith("deadlock")
     assert r.penetrations == 0 and r.collisions == 0
 
 
-def test_run_epbha_stops_at_max_steps() -> None:
+def test_the_epbha_loop_stops_at_max_steps() -> None:
     scene = thesis_scenes()[0]
-    r = run_epbha(scene.world, scene.start_n, scene.goal_n, max_steps=5)
-    assert r.status is PlanStatus.MAX_STEPS and r.steps == 5
+    r = fly_epbha_scene(scene.world, scene.start_n, scene.goal_n, max_steps=5)
+    assert r.reason == "no goal within 5 steps" and r.steps == 5
 
 
 def test_noisy_sensors_still_reach_the_thesis_scenes() -> None:
@@ -258,17 +258,17 @@ def test_noisy_sensors_still_reach_the_thesis_scenes() -> None:
     from planners.proximity import ProximityParams
 
     for scene in thesis_scenes():
-        r = run_epbha(scene.world, scene.start_n, scene.goal_n,
+        r = fly_epbha_scene(scene.world, scene.start_n, scene.goal_n,
                       proximity=ProximityParams(noise_sigma_m=0.01),
                       rng=np.random.default_rng(7))
         assert r.reached and r.collisions == 0, scene.name
 
 
-def test_run_epbha_refuses_a_start_inside_an_obstacle() -> None:
+def test_the_epbha_loop_refuses_a_start_inside_an_obstacle() -> None:
     scene = thesis_scenes()[0]
     inside_table = (3.5, 2.0, -0.78)
-    r = run_epbha(scene.world, inside_table, scene.goal_n)
-    assert r.status is PlanStatus.START_BLOCKED and len(r.path) == 1
+    r = fly_epbha_scene(scene.world, inside_table, scene.goal_n)
+    assert r.reason == START_BLOCKED and len(r.path) == 1
 
 
 def test_ceiling_high_wall_is_gone_around_below_the_maximum_altitude() -> None:
@@ -281,7 +281,7 @@ def test_ceiling_high_wall_is_gone_around_below_the_maximum_altitude() -> None:
         Box("wing", (1.9, 0.8, -2.5), (2.55, 0.85, 0.0)),
     ))
     params = EpbhaParams(max_alt_m=1.6)
-    r = run_epbha(world, (0.5, 1.2, -1.0), (4.5, 1.2, -1.0), params, max_steps=800)
-    assert r.status is PlanStatus.REACHED and r.collisions == 0
+    r = fly_epbha_scene(world, (0.5, 1.2, -1.0), (4.5, 1.2, -1.0), params, max_steps=800)
+    assert r.reached and r.collisions == 0
     assert max(-p[2] for p in r.path) <= 1.6 + 1e-9
     assert max(p[1] for p in r.path) > 2.2  # went around the east end

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
+from gcs.mission.kinematic_runs import fly_epbha_scene
 from planners.epbha.planner import EpbhaParams, Move
-from planners.epbha.run import run_epbha
 from planners.epbha.wedges import wedge_clear, wedge_edges
 from planners.geometry import Box, World
 from planners.kinematic import KinematicParams
@@ -67,7 +67,7 @@ def test_turning_over_a_box_top_just_below_keeps_the_body_clear() -> None:
         Box("low_box", (1.19, 1.19, -0.8145), (2.17, 1.98, 0.0)),
         Box("pillar", (2.16, 0.69, -2.5), (2.98, 1.62, 0.0)),
     ))
-    r = run_epbha(world, (0.5, 0.98, -0.96), (5.5, 3.05, -0.94), max_steps=600)
+    r = fly_epbha_scene(world, (0.5, 0.98, -0.96), (5.5, 3.05, -0.94), max_steps=600)
     assert r.collisions == 0
     assert r.min_clearance_m >= KinematicParams().body_radius_m
 
@@ -85,6 +85,6 @@ def test_random_rooms_where_the_body_once_touched_are_flown_clear(seed: int, ind
     for _ in range(index):
         random_room(rng)
     scene = random_room(rng)
-    r = run_epbha(scene.world, scene.start_n, scene.goal_n, max_steps=3000)
+    r = fly_epbha_scene(scene.world, scene.start_n, scene.goal_n, max_steps=3000)
     assert r.collisions == 0 and r.penetrations == 0
     assert r.min_clearance_m >= KinematicParams().body_radius_m

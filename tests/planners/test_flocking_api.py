@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
+from gcs.mission.kinematic_flock import fly_flock_scene
 from planners.flocking.formation import Role
 from planners.flocking.planner import FlockMission, FlockPlanner, Phase, VehicleMode
 from planners.flocking.scenes import FlockScene, open_hall, table_room
-from planners.flocking.sim import FlockPlannerKind, run_flock
+from planners.flocking.swarm import FlockPlannerKind
 from planners.geometry import Box, World
 from planners.proximity import ProximityReading
-from planners.result import PlanStatus
 
 
 def test_step_keys_everything_by_vehicle_id() -> None:
@@ -40,9 +40,9 @@ def test_step_refuses_missing_vehicles_and_bad_teams() -> None:
 def test_runner_refuses_bad_runs() -> None:
     rng = np.random.default_rng(0)
     with pytest.raises(ValueError, match="n_vehicles"):
-        run_flock(open_hall(), 0, FlockPlannerKind.TRIANGULAR, 10, rng)
+        fly_flock_scene(open_hall(), 0, FlockPlannerKind.TRIANGULAR, 10, rng)
     with pytest.raises(ValueError, match="max_steps"):
-        run_flock(open_hall(), 3, FlockPlannerKind.TRIANGULAR, 0, rng)
+        fly_flock_scene(open_hall(), 3, FlockPlannerKind.TRIANGULAR, 0, rng)
     hall = open_hall()
     blocked = FlockScene(
         "blocked",
@@ -51,21 +51,20 @@ def test_runner_refuses_bad_runs() -> None:
         hall.common_goal_n,
     )
     with pytest.raises(ValueError, match="inside an obstacle"):
-        run_flock(blocked, 5, FlockPlannerKind.TRIANGULAR, 10, rng)
+        fly_flock_scene(blocked, 5, FlockPlannerKind.TRIANGULAR, 10, rng)
 
 
 def test_a_run_that_runs_out_of_steps_says_so() -> None:
-    r = run_flock(open_hall(), 3, FlockPlannerKind.TRIANGULAR, 20, np.random.default_rng(0))
-    assert r.status is PlanStatus.MAX_STEPS
-    assert "3 of 3 vehicles short" in r.reason
+    r = fly_flock_scene(open_hall(), 3, FlockPlannerKind.TRIANGULAR, 20, np.random.default_rng(0))
+    assert not r.reached and r.reason == "vehicles [1, 2, 3] short of their goals"
     assert r.leader_time_s is None
     assert r.track_n.shape == (21, 3, 3)
 
 
 def test_table_room_leader_ends_under_the_table() -> None:
     scene = table_room()
-    r = run_flock(scene, 5, FlockPlannerKind.TRIANGULAR, 600, np.random.default_rng(0))
-    assert r.status is PlanStatus.REACHED, r.reason
+    r = fly_flock_scene(scene, 5, FlockPlannerKind.TRIANGULAR, 600, np.random.default_rng(0))
+    assert r.reached, r.reason
     assert r.collisions == 0
     end = r.paths_n[1][-1]
     top = next(b for b in scene.world.obstacles if b.name == "table-top")
@@ -100,9 +99,10 @@ def test_a_team_holding_its_slots_reads_only_the_settled_flags() -> None:
 
 
 def test_run_books_every_message_of_the_flock() -> None:
-    r = run_flock(open_hall(), 5, FlockPlannerKind.TRIANGULAR, 80, np.random.default_rng(0))
+    r = fly_flock_scene(open_hall(), 5, FlockPlannerKind.TRIANGULAR, 80, np.random.default_rng(0))
     assert r.state_reads > r.messages_sent > 0
     assert r.messages_total == r.messages_sent + r.state_reads
-    assert r.messages_total <= r.steps * (5 * 4 + 4)  # all pairs plus eq. 9.1's 4 per step
-    rey = run_flock(open_hall(), 5, FlockPlannerKind.REYNOLDS, 80, np.random.default_rng(0))
-    assert rey.state_reads == 0 and rey.messages_total == rey.steps * 5 * 4
+    # all pairs plus eq. 9.1's 4 per plan; the loop plans once more than it moves
+    assert r.messages_total <= (r.steps + 1) * (5 * 4 + 4)
+    rey = fly_flock_scene(open_hall(), 5, FlockPlannerKind.REYNOLDS, 80, np.random.default_rng(0))
+    assert rey.state_reads == 0 and rey.messages_total == (rey.steps + 1) * 5 * 4

@@ -3,21 +3,22 @@
 import numpy as np
 import pytest
 
+from gcs.mission.kinematic_flock import fly_flock_scene
 from planners.flocking.planner import FlockParams
 from planners.flocking.scenes import narrow_opening
-from planners.flocking.sim import FlockPlannerKind, run_flock
-from planners.result import PlanStatus
+from planners.flocking.swarm import FlockPlannerKind
 
 
 @pytest.fixture(scope="module")
 def door_run():
     scene = narrow_opening()
-    return scene, run_flock(scene, 5, FlockPlannerKind.TRIANGULAR, 600, np.random.default_rng(3))
+    rng = np.random.default_rng(3)
+    return scene, fly_flock_scene(scene, 5, FlockPlannerKind.TRIANGULAR, 600, rng)
 
 
 def test_door_is_passed_without_collision_and_above_the_safe_distance(door_run) -> None:
     _, r = door_run
-    assert r.status is PlanStatus.REACHED, r.reason
+    assert r.reached, r.reason
     assert r.collisions == 0
     assert r.min_separation_m >= FlockParams().formation.safe_distance_m - 1e-9
 

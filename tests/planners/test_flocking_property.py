@@ -4,9 +4,10 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from gcs.mission.kinematic_flock import fly_flock_scene
 from planners.flocking.planner import FlockParams
 from planners.flocking.scenes import CRUISE_Z_M, ROOM, FlockScene
-from planners.flocking.sim import FlockPlannerKind, run_flock
+from planners.flocking.swarm import FlockPlannerKind
 from planners.geometry import Box, World
 
 
@@ -36,7 +37,7 @@ def test_no_collision_and_separation_above_safe_distance(
     case: tuple[FlockScene, int], seed: int
 ) -> None:
     scene, n = case
-    r = run_flock(scene, n, FlockPlannerKind.TRIANGULAR, 250, np.random.default_rng(seed))
+    r = fly_flock_scene(scene, n, FlockPlannerKind.TRIANGULAR, 250, np.random.default_rng(seed))
     assert r.obstacle_collisions == 0
     assert r.vehicle_collisions == 0
     assert r.min_separation_m >= FlockParams().formation.safe_distance_m - 1e-9

@@ -5,13 +5,13 @@ import math
 import numpy as np
 import pytest
 
+from gcs.mission.kinematic_runs import fly_radiation_field
 from planners.radiation import (
     Phase,
     RadiationMapper,
     RadiationMapperParams,
     Status,
     fan_points,
-    run_radiation,
     sampling_distance_m,
 )
 from planners.radiation.field import RadiationField
@@ -27,7 +27,7 @@ ONE = RadiationField.from_tuples([(3.0, 2.0, 4000.0)], 40.0)
 @pytest.fixture(scope="module")
 def three_source_run():
     """One seeded planner run on the thesis's three-source floor."""
-    return run_radiation(THREE, RadiationMapperParams(), np.random.default_rng(2026), 400)
+    return fly_radiation_field(THREE, RadiationMapperParams(), np.random.default_rng(2026), 400)
 
 
 def test_three_source_floor_encloses_every_source(three_source_run) -> None:
@@ -105,7 +105,7 @@ def test_garbled_readings_are_dropped_and_counted() -> None:
 
 
 def test_spent_budget_fails_with_a_reason_and_a_real_partial_map() -> None:
-    r = run_radiation(ONE, None, np.random.default_rng(1), max_samples=12)
+    r = fly_radiation_field(ONE, None, np.random.default_rng(1), max_samples=12)
     assert r.status is Status.FAILED
     assert "budget" in r.reason
     assert r.n_samples == 12
@@ -160,7 +160,7 @@ def test_five_sources_of_unequal_strength_are_all_enclosed() -> None:
          (6.0, 6.0, 2600.0)],
         70.0,
     )  # fmt: skip
-    r = run_radiation(field, None, np.random.default_rng(5), 400)
+    r = fly_radiation_field(field, None, np.random.default_rng(5), 400)
     assert r.status is Status.REACHED, r.reason
     assert r.sources_enclosed == 5 and len(r.hotspots) == 5
     assert r.iou >= 0.85
@@ -169,12 +169,12 @@ def test_five_sources_of_unequal_strength_are_all_enclosed() -> None:
 
 def test_run_needs_room_for_a_map() -> None:
     with pytest.raises(ValueError, match="max_samples"):
-        run_radiation(ONE, None, np.random.default_rng(0), max_samples=1)
+        fly_radiation_field(ONE, None, np.random.default_rng(0), max_samples=1)
 
 
 def test_a_floor_without_a_hotspot_fails_and_says_why() -> None:
     faint = RadiationField.from_tuples([(0.0, 0.0, 20.0)], 50.0)
-    r = run_radiation(faint, None, np.random.default_rng(3), 400)
+    r = fly_radiation_field(faint, None, np.random.default_rng(3), 400)
     assert r.status is Status.FAILED
     assert "no hotspot" in r.reason
     assert r.hotspots == ()
@@ -219,7 +219,7 @@ def test_gp_mapped_lawnmower_beats_log_linear_at_coarse_spacing() -> None:
 
 def test_counting_to_a_target_cuts_the_dwell_and_still_maps_every_source() -> None:
     p = RadiationMapperParams(target_counts=800)
-    r = run_radiation(THREE, p, np.random.default_rng(2026), 400)
+    r = fly_radiation_field(THREE, p, np.random.default_rng(2026), 400)
     assert r.status is Status.REACHED, r.reason
     assert r.sources_enclosed == 3 and r.iou >= 0.85
     mapper = RadiationMapper(p)

@@ -4,8 +4,8 @@ import math
 
 import pytest
 
+from gcs.mission.kinematic_runs import fly_epbha_scene
 from planners.epbha.return_memory import ReturnMemory
-from planners.epbha.run import run_epbha
 from planners.geometry import Box, World
 from planners.proximity import Facing, ProximityReading
 
@@ -76,7 +76,7 @@ def test_an_edge_gone_into_a_blind_wedge_is_not_passed_within_the_body() -> None
     # vehicle flew that line within its 0.15 m body.
     room = Box("room", (-1.0, -1.5, -2.5), (3.0, 1.5, 0.0))
     world = World(room, (Box("crate", (0.25, -0.5, -0.917), (1.0, 0.0, 0.0)),))
-    r = run_epbha(world, (0.0, 0.0, -1.0), (2.0, 0.1, -1.0))
+    r = fly_epbha_scene(world, (0.0, 0.0, -1.0), (2.0, 0.1, -1.0))
     assert r.path[1] == pytest.approx((0.0, 0.1, -1.0))  # the side step that hides the edge
     assert r.reached and r.collisions == 0
     assert r.min_clearance_m >= 0.15

@@ -3,24 +3,26 @@
 import numpy as np
 import pytest
 
+from gcs.mission.kinematic_flock import fly_flock_scene
 from planners.flocking.planner import FlockMission
 from planners.flocking.reynolds import ReynoldsPlanner
 from planners.flocking.scenes import open_hall
-from planners.flocking.sim import FlockPlannerKind, run_flock
+from planners.flocking.swarm import FlockPlannerKind
 from planners.proximity import ProximityReading
 
 
 def test_messages_are_n_times_n_minus_one_per_step() -> None:
-    r = run_flock(open_hall(), 5, FlockPlannerKind.REYNOLDS, 40, np.random.default_rng(0))
-    assert r.messages_sent == 40 * 5 * 4
+    r = fly_flock_scene(open_hall(), 5, FlockPlannerKind.REYNOLDS, 40, np.random.default_rng(0))
+    # 40 moves, 41 plans: the loop plans once more than it moves
+    assert r.steps == 40 and r.messages_sent == 41 * 5 * 4
 
 
 def test_open_hall_is_reached_with_the_flock_s_targets() -> None:
     scene = open_hall()
-    r = run_flock(scene, 5, FlockPlannerKind.REYNOLDS, 400, np.random.default_rng(0))
+    r = fly_flock_scene(scene, 5, FlockPlannerKind.REYNOLDS, 400, np.random.default_rng(0))
     assert r.status.value == "reached", r.reason
     assert r.collisions == 0
-    tri = run_flock(scene, 5, FlockPlannerKind.TRIANGULAR, 400, np.random.default_rng(0))
+    tri = fly_flock_scene(scene, 5, FlockPlannerKind.TRIANGULAR, 400, np.random.default_rng(0))
     for v in r.paths_n:
         assert np.allclose(r.paths_n[v][-1], tri.paths_n[v][-1], atol=0.06)
 

@@ -1,4 +1,4 @@
-"""The typed outcome every planner of this package returns."""
+"""What a grid search baseline (A*, D* Lite) returns: how its search ended, the path flown."""
 
 from __future__ import annotations
 
@@ -9,28 +9,27 @@ from dataclasses import dataclass
 from planners.geometry import Vec3
 
 
-class PlanStatus(enum.Enum):
-    """How a planning run ended."""
+class SearchStatus(enum.Enum):
+    """How a grid search ended."""
 
     REACHED = "reached"
     GOAL_UNREACHABLE = "goal unreachable"  # a complete search proved no path exists
-    DEADLOCK = "deadlock"  # the planner hovers: no move it allows is free, or it loops
     MAX_STEPS = "max steps"  # the step budget ran out before the goal
     START_BLOCKED = "start blocked"  # the start (or goal) is inside an obstacle's clearance
 
 
 @dataclass(frozen=True, slots=True)
-class PlanResult:
-    """A planner's run: status, the path flown (never invented), effort and safety numbers.
+class SearchResult:
+    """A search baseline's run: status, the path flown (never invented), effort and safety numbers.
 
     `path` holds the positions visited, start first; when the goal was not reached it ends
     where the vehicle stopped. `cost_evaluations` counts every cost computed for a candidate
-    coordinate (EPBHA's cost table entries, A*'s and D* Lite's edge relaxations);
-    `node_expansions` counts nodes popped and expanded by a graph search (0 for EPBHA).
+    coordinate (an edge relaxation, the unit EPBHA's cost table entries are counted in too);
+    `node_expansions` counts nodes popped and expanded.
     """
 
     planner: str
-    status: PlanStatus
+    status: SearchStatus
     path: tuple[Vec3, ...]
     cost_evaluations: int
     node_expansions: int
@@ -43,7 +42,7 @@ class PlanResult:
     @property
     def reached(self) -> bool:
         """True when the goal was reached."""
-        return self.status is PlanStatus.REACHED
+        return self.status is SearchStatus.REACHED
 
     @property
     def path_length_m(self) -> float:
