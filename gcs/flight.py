@@ -17,6 +17,7 @@ from gcs.control.attitude import yaw_from_quat
 from gcs.control.position_controller import PositionSetpoint
 from gcs.errors import FlightFailed
 from gcs.flight_plan import PHASE_STATES, FlightPlan, FlightSample, FlightSummary, Phase
+from gcs.landing import descend, hand_over, may_descend
 from gcs.launch import Launch, LaunchRules, LaunchStage, vehicle_said
 from gcs.scoring import (
     ESTIMATE,
@@ -43,8 +44,8 @@ def _truth_alt(snap: StationSnapshot) -> float | None:
 
 
 class _FlyPort:
-    """How the launch looks and waits in a flight: every look checks the flight's phase; the
-    runner's idle (a sleep, or in lockstep one tick) between looks."""
+    """How the launch and the landing look and wait in a flight: every look checks the flight's
+    phase; the runner's idle (a sleep, or in lockstep one tick) between looks."""
 
     def __init__(self, runner: FlightRunner) -> None:
         self.runner = runner
@@ -80,6 +81,7 @@ class FlightRunner:
                  rest_alt_m: float | None = None,
                  idle: Callable[[], None] | None = None, sysid: int = 1) -> None:
         self.station = station
+        self.sysid = sysid  # the vehicle's system id, as failure lines name it
         # between looks at the station: sleep while its loop thread flies, or (lockstep) run
         # its next tick, the simulation included
         self.idle = idle or (lambda: time.sleep(POLL_S))
@@ -96,7 +98,8 @@ class FlightRunner:
         # the flight with a clear message instead of scoring a flight nobody is flying
         self.expected_modes: set[int] = {FlightMode.STABILIZE}
         station.add_listener(self._sample)
-        self.launch = Launch({sysid: station}, _FlyPort(self),
+        self.port = _FlyPort(self)
+        self.launch = Launch({sysid: station}, self.port,
                              LaunchRules(rest_s=plan.rest_s, arm_timeout_s=plan.arm_timeout_s))
 
     def _sample(self, snap: StationSnapshot) -> None:
@@ -197,35 +200,33 @@ class FlightRunner:
         self.land()
 
     def land(self) -> None:
-        """Descend under PC control to a few cm, then ask for LAND mode, which touches down and
-        disarms by itself (a disarm request follows if it does not). PC hold stays on until a
-        heartbeat shows LAND, so the vehicle is never left without a throttle."""
+        """Descend under PC control to a few cm, then LAND touches down and disarms
+        (`gcs.landing`, as for a team's vehicles); FlightFailed when either does not."""
         p = self.plan
         st = self.station
         self.phase = Phase.LAND
         self._target = 0.0
-        if st.snapshot(loop_stats=False).state is SupervisorState.HOLD:
-            st.alt_hold(True, 0.0, rate_mps=p.descent_mps)
-            start = st.snapshot(loop_stats=False).estimate
-            top = start.alt_m if start is not None else p.alt_m
-            self.wait("descent", lambda s: s.estimate is not None
-                       and s.estimate.alt_m < p.handover_alt_m, top / p.descent_mps + 15.0)
-        st.set_sticks(1500, 1500, 1500, 1000)
+        snap = st.snapshot(loop_stats=False)
+        if may_descend(snap):
+            top = snap.estimate.alt_m if snap.estimate is not None else p.alt_m
+            timeout_s = top / p.descent_mps + 15.0
+            if not descend(st, self.port, self.sysid, p.descent_mps, timeout_s,
+                           p.handover_alt_m):
+                raise FlightFailed(f"descent did not happen within {timeout_s:g} s "
+                                   f"({self._why(st.snapshot(loop_stats=False))})")
         self.expected_modes.add(FlightMode.LAND)
-        st.set_mode(FlightMode.LAND)
-        try:
-            self.wait("touch-down and disarm in LAND", lambda s: not s.armed, 15.0)
-        except FlightFailed:
-            for _ in range(3):
-                st.request_disarm()
-                try:
-                    self.wait("disarm", lambda s: not s.armed, 3.0)
-                    break
-                except FlightFailed:
-                    continue
-            else:
-                raise
+        if not hand_over(st, self._waited, (15.0, 3.0, 3.0, 3.0)):
+            raise FlightFailed(f"the vehicle did not disarm in LAND nor on four requests "
+                               f"({self._why(st.snapshot(loop_stats=False))})")
         self.phase = Phase.DONE
+
+    def _waited(self, pred: Callable[[StationSnapshot], bool], timeout_s: float) -> bool:
+        """`wait` as a yes or no (any failure it sees is a no)."""
+        try:
+            self.wait("disarm", pred, timeout_s)
+        except FlightFailed:
+            return False
+        return True
 
     # -------------------------------------------------------------- scoring
     def summary(self, truth: Series | None = None) -> FlightSummary:

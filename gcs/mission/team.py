@@ -10,8 +10,8 @@ from __future__ import annotations
 import itertools
 import math
 
-from firmware_link.records import FlightMode
 from gcs.errors import RuntimeFault
+from gcs.landing import descend, hand_over, may_descend
 from gcs.launch import Launch, LaunchStage
 from gcs.mission.craft import Craft, CraftPhase, go_to_all
 from gcs.mission.events import EventLog, MissionEvent
@@ -24,9 +24,7 @@ from planners.geometry import Vec3
 POSITION_HOLD_FROM_M = 0.3  # take-off: hold position only once clear of the floor's friction
 CLIMB_MPS = 0.4
 DESCENT_MPS = 0.3
-HANDOVER_ALT_M = 0.15  # below this (estimate), LAND mode finishes the touch-down
-STILL_MPS = 0.05  # sinking slower than this (mocap) for STILL_S: standing on something
-STILL_S = 1.0
+DISARM_WAITS_S = (10.0, 10.0, 10.0, 10.0)  # in LAND, a disarm request after each
 POLL_S = 0.1
 STAGE_EVENTS = {LaunchStage.ARMING: MissionEvent.ARMING, LaunchStage.ARMED: MissionEvent.ARMED,
                 LaunchStage.DISARMED: MissionEvent.DISARMED_ON_FLOOR}
@@ -48,7 +46,8 @@ class Team:
         self.min_separation_m = math.inf
         self.armed_at_s: dict[int, float] = {}
         self.gone: dict[int, str] = {}  # vehicles the station no longer flies, and why
-        self.launch = Launch({v: c.station for v, c in crafts.items()}, _TeamPort(self))
+        self.port = _TeamPort(self)
+        self.launch = Launch({v: c.station for v, c in crafts.items()}, self.port)
 
     def event(self, what: MissionEvent, vehicle: int | None = None, detail: str = "") -> None:
         """Tell the pilot and the recording."""
@@ -170,48 +169,20 @@ class Team:
             self.event(MissionEvent.LANDED, v)
 
     def _land_one(self, c: Craft) -> None:
-        """Descend under PC control until near the surface below or no longer sinking, then
-        LAND mode touches down and disarms (a disarm request follows if it does not).
-
-        Over a box the sonar-based estimate may still be measured from the floor, so it never
-        falls below the hand-over height: motion capture seeing no descent for a second ends the
-        PC descent too.
-        """
+        """Descend under PC control, then LAND touches down and disarms (`gcs.landing`, as for
+        `fly`); a descent that takes too long is handed to LAND all the same."""
         st = c.station
         c.release()
-        st.alt_hold(True, 0.0, rate_mps=DESCENT_MPS)
-        deadline = self.clock.now_s() + self.spec.takeoff_alt_m / DESCENT_MPS + 20.0
-        still_since: float | None = None
-        last: tuple[float, float] | None = None  # (station time, mocap z)
-        while self.clock.now_s() < deadline:
-            snap = c.snapshot()
-            now = self.clock.now_s()
-            if snap.estimate is not None and snap.estimate.alt_m < HANDOVER_ALT_M:
-                break
-            z = snap.mocap.pos_n[2] if snap.mocap is not None else None
-            if z is not None and last is not None and now > last[0]:
-                sinking_mps = (z - last[1]) / (now - last[0])
-                if sinking_mps < STILL_MPS:
-                    still_since = now if still_since is None else still_since
-                    if now - still_since >= STILL_S:
-                        break
-                else:
-                    still_since = None
-            if z is not None:
-                last = (now, z)
-            self.pause()
-        st.set_sticks(1500, 1500, 1500, 1000)
-        st.set_mode(FlightMode.LAND)  # PC hold stays on until a heartbeat shows LAND
-        for _ in range(4):
-            if c.wait(lambda s: not s.armed, 10.0):
-                return
-            st.request_disarm()
-        raise RuntimeFault(f"vehicle {c.sysid} did not disarm after landing")
+        if may_descend(c.snapshot()):
+            descend(st, self.port, c.sysid, DESCENT_MPS,
+                    self.spec.takeoff_alt_m / DESCENT_MPS + 20.0)
+        if not hand_over(st, c.wait, DISARM_WAITS_S):
+            raise RuntimeFault(f"vehicle {c.sysid} did not disarm after landing")
 
 
 class _TeamPort:
-    """How the launch looks and waits in a mission: each vehicle's craft, 10 Hz on the team's
-    clock, its stages recorded as mission events."""
+    """How the launch and the landing look and wait in a mission: each vehicle's craft, 10 Hz
+    on the team's clock, the launch's stages recorded as mission events."""
 
     def __init__(self, team: Team) -> None:
         self.team = team
