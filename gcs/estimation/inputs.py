@@ -51,4 +51,5 @@ _ISA_EXP = 5.25588
 def baro_altitude_m(pressure_pa: float) -> float:
     """ISA altitude of a static pressure. Only its changes matter: the filter that uses it
     estimates the offset to the altitude above the floor (weather, calibration, drift)."""
-    return (1.0 - (pressure_pa / _ISA_P0_PA) ** (1.0 / _ISA_EXP)) / _ISA_K_PER_M
+    ratio: float = (pressure_pa / _ISA_P0_PA) ** (1.0 / _ISA_EXP)  # float ** float is Any
+    return (1.0 - ratio) / _ISA_K_PER_M
