@@ -231,7 +231,7 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
         v.station.start()
     printer = LivePrinter(session.clock) if live else None
     runner = FlightRunner(v.station, plan, printer,
-                          idle=getattr(session, "tick", None))
+                          idle=getattr(session, "tick", None), sysid=v.sysid)
     path = str(v.recorder.path) if v.recorder is not None else None
     try:
         runner.fly()

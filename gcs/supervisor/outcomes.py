@@ -24,7 +24,8 @@ class OutcomeKind(enum.Enum):
 
 
 ARM_FAILED = frozenset({OutcomeKind.ARM_REFUSED, OutcomeKind.ARM_TIMED_OUT})
-"""Outcomes after which an arm request is over without an armed vehicle."""
+"""Outcomes after which an arm request is over without an armed vehicle. An ignored request is
+not one: the vehicle may already be armed (by the pilot's radio, say)."""
 
 
 @dataclass(frozen=True, slots=True)
