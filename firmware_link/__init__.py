@@ -34,7 +34,6 @@ from firmware_link.parm_file import (
     render_parm,
     write_parm_file,
 )
-from firmware_link.signing import key_from_passphrase, load_signing_key
 from firmware_link.stats import LinkStats
 from firmware_link.streams import (
     BringUpReport,
@@ -72,8 +71,6 @@ __all__ = [
     "dialect_of_frame",
     "diff_params",
     "format_param_value",
-    "key_from_passphrase",
-    "load_signing_key",
     "parse_connection_string",
     "parse_parm",
     "plan_streams",

@@ -18,11 +18,11 @@ from types import FrameType
 
 from sitl.autopilot import Profile
 from sitl.autopilot.profile import COPTER4_VERSIONS
-from sitl.link.codec import SigningKeyError, load_signing_key
 from sitl.link.endpoints import EndpointError
 from sitl.link.server import TCP_BASE_PORT, EndpointPlan, SitlServer
 from sitl.simulation import Simulation
 from sitl.world import WorldError, default_world, load_world
+from worldfile import SigningKeyError, load_signing_key
 
 MOCAP_DEFAULT_PORT = 5750
 MAX_VEHICLES = 20

@@ -1,5 +1,6 @@
-"""The world-file format, read alike by the simulator and the station (neither imports the
-other): keys, defaults, validation, one error wording; the one TOML reader of the project."""
+"""The files the simulator and the station both read (neither imports the other): the world
+file's format (keys, defaults, validation, one error wording), the project's one TOML reader and
+the MAVLink signing key file."""
 
 from worldfile.placement import vehicle_start
 from worldfile.schema import (
@@ -16,6 +17,7 @@ from worldfile.schema import (
     load_world_file,
     parse_world,
 )
+from worldfile.signing_key import SigningKeyError, key_from_passphrase, load_signing_key
 from worldfile.toml_file import TomlFileError, parse_toml, read_toml
 
 __all__ = [
@@ -25,11 +27,14 @@ __all__ = [
     "FloorPatch",
     "GeoOrigin",
     "RadiationSource",
+    "SigningKeyError",
     "TomlFileError",
     "Vec2",
     "Vec3",
     "WorldFileError",
     "WorldSpec",
+    "key_from_passphrase",
+    "load_signing_key",
     "load_world_file",
     "parse_toml",
     "parse_world",

@@ -32,13 +32,13 @@ from firmware_link import (
     VehicleLink,
     diff_params,
     format_param_value,
-    load_signing_key,
     read_parm_file,
     write_parm_file,
 )
 from firmware_link.params import check_param_name
 from gcs.errors import RuntimeFault, UsageError
 from gcs.sitl_process import SitlOptions, SitlProcess
+from worldfile import load_signing_key
 
 # Names that moved between firmware versions: a pilot's habit from one meets the other.
 RENAMED = {

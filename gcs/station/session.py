@@ -23,7 +23,6 @@ from firmware_link import (
     MocapLink,
     ParamError,
     VehicleLink,
-    load_signing_key,
 )
 from firmware_link.records import Battery, Dialect, MocapPose
 from firmware_link.truth_link import TruthLink, TruthRecorder
@@ -39,6 +38,7 @@ from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlOptions, SitlProcess
 from gcs.station.guardian import Guardian, GuardianSetup
 from gcs.station.station import Station
+from worldfile import load_signing_key
 
 CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
 STREAM_RATE_HZ = 40.0

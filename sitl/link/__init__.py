@@ -4,7 +4,7 @@ Simulation behind them is `sitl.link.server.SitlServer` (not imported here: it n
 simulation, which needs this package)."""
 
 from sitl.link.channel import COMPANION_COMPID, Channel
-from sitl.link.codec import MavCodec, SigningKeyError, load_signing_key
+from sitl.link.codec import MavCodec
 from sitl.link.endpoints import (
     EndpointError,
     PtySerialEndpoint,
@@ -23,12 +23,10 @@ __all__ = [
     "MavCodec",
     "PtySerialEndpoint",
     "SensorCache",
-    "SigningKeyError",
     "Stream",
     "StreamSchedule",
     "TcpServerEndpoint",
     "UdpEndpoint",
     "VehicleLink",
     "VehicleView",
-    "load_signing_key",
 ]

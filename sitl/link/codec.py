@@ -13,12 +13,10 @@ zero-fills the missing extensions.
 
 from __future__ import annotations
 
-import hashlib
 import inspect
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from pymavlink.dialects.v10 import ardupilotmega as mavlink_v1
@@ -103,30 +101,6 @@ class _Messages:
 
 
 messages = _Messages()
-
-
-class SigningKeyError(ValueError):
-    """A signing key file that cannot be used."""
-
-
-def load_signing_key(path: str | Path) -> bytes:
-    """Key file: 32 raw bytes, or a one-line passphrase whose SHA-256 is the key (as MAVProxy)."""
-    file = Path(path)
-    try:
-        data = file.read_bytes()
-    except OSError as exc:
-        raise SigningKeyError(f"signing key {file}: cannot read: {exc.strerror or exc}") from None
-    if len(data) == SIGNING_KEY_BYTES:
-        return data
-    try:
-        text = data.decode("utf-8").strip()
-    except UnicodeDecodeError:
-        raise SigningKeyError(
-            f"signing key {file}: {len(data)} bytes of binary; expected 32 bytes or a passphrase"
-        ) from None
-    if not text or "\n" in text:
-        raise SigningKeyError(f"signing key {file}: expected 32 raw bytes or a one-line passphrase")
-    return hashlib.sha256(text.encode("utf-8")).digest()
 
 
 class _Sink:

@@ -216,7 +216,7 @@ def test_watchdog_over_the_pseudo_terminal() -> None:
 def test_signed_copter4_link_and_a_strangers_unsigned_override(tmp_path) -> None:
     key_file = tmp_path / "signing.key"
     key_file.write_text(PASSPHRASE + "\n")
-    from firmware_link import load_signing_key
+    from worldfile import load_signing_key
 
     key = load_signing_key(key_file)
     sitl = start_sitl("--tcp", "0", "--profile", "copter4", "--signing-key", str(key_file))

@@ -13,13 +13,13 @@ from firmware_link import (
     LinkError,
     LinkUsageError,
     VehicleLink,
-    key_from_passphrase,
 )
 from firmware_link.forward_peers import TCP_BACKLOG_BYTES, parse_forward_url
 from firmware_link.protocol import mavlink
 from firmware_link.records import LinkEvent, LinkEventKind, RcCommand
 from firmware_link.signing import signing_timestamp
 from tests.firmware_link.peer import FakeVehicle
+from worldfile import key_from_passphrase
 
 KEY = key_from_passphrase("quadgcs test key")
 OTHER_GCS = 254  # the forwarded station's system id, so the vehicle can tell who sent what

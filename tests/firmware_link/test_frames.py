@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from firmware_link import dialect_of_frame, key_from_passphrase, load_signing_key
-from firmware_link.errors import LinkUsageError
+from firmware_link import dialect_of_frame
 from firmware_link.frames import FrameEndpoint
 from firmware_link.protocol import WireVersion, mavlink
 from firmware_link.records import Dialect
+from worldfile import SigningKeyError, key_from_passphrase, load_signing_key
 
 
 class Clock:
@@ -117,7 +117,7 @@ def test_key_files_raw_or_passphrase(tmp_path) -> None:
     assert len(key_from_passphrase("x")) == 32
     binary = tmp_path / "bad.key"
     binary.write_bytes(b"\xff\xfe" * 5)
-    with pytest.raises(LinkUsageError, match="expected 32 raw bytes"):
+    with pytest.raises(SigningKeyError, match="expected 32 raw bytes"):
         load_signing_key(binary)
-    with pytest.raises(LinkUsageError, match="cannot read"):
+    with pytest.raises(SigningKeyError, match="cannot read"):
         load_signing_key(tmp_path / "missing.key")

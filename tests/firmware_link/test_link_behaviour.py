@@ -10,13 +10,14 @@ from collections.abc import Iterator
 
 import pytest
 
-from firmware_link import LinkError, LinkUsageError, ParamError, VehicleLink, key_from_passphrase
+from firmware_link import LinkError, LinkUsageError, ParamError, VehicleLink
 from firmware_link.connection import parse_connection_string
 from firmware_link.frames import FrameEndpoint
 from firmware_link.protocol import WireVersion
 from firmware_link.records import Attitude, Dialect, FlightMode, LinkEventKind, RcCommand
 from tests.firmware_link.peer import FakeVehicle, wait_until
 from tests.firmware_link.test_link_peer import events, poll_until
+from worldfile import key_from_passphrase
 
 
 @pytest.fixture

@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterator
 
 import pytest
 
-from firmware_link import LinkError, LinkUsageError, VehicleLink, key_from_passphrase
+from firmware_link import LinkError, LinkUsageError, VehicleLink
 from firmware_link.protocol import mavlink
 from firmware_link.records import (
     CommandAck,
@@ -24,6 +24,7 @@ from firmware_link.records import (
     RcCommand,
 )
 from tests.firmware_link.peer import FakeVehicle, wait_until
+from worldfile import key_from_passphrase
 
 KEY = key_from_passphrase("quadgcs test key")
 

@@ -15,11 +15,12 @@ from types import SimpleNamespace
 
 import pytest
 
-from firmware_link import VehicleLink, key_from_passphrase
+from firmware_link import VehicleLink
 from firmware_link.records import FlightMode, LinkEvent, LinkEventKind
 from gcs.station.guardian import Guardian, GuardianSetup
 from gcs.supervisor import SupervisorState
 from tests.firmware_link.peer import FakeVehicle, wait_until
+from worldfile import key_from_passphrase
 
 KEY = key_from_passphrase("quadgcs guardian key")
 HOVER_US = 1480
