@@ -15,7 +15,8 @@ from lab.campaign.results import (
     summary_table,
 )
 from lab.campaign.search import BEST_NAME, SearchOutcome, run_search
-from lab.campaign.spec import BaseMission, Campaign, CampaignError, load_campaign
+from lab.campaign.spec import load_campaign
+from lab.campaign.types import BaseMission, Campaign, CampaignError
 
 __all__ = [
     "BEST_NAME",

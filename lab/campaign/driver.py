@@ -20,7 +20,7 @@ from lab.campaign.pool import run_all
 from lab.campaign.progress import Progress
 from lab.campaign.results import RESULTS_NAME, read_results, write_results
 from lab.campaign.run import RunSpec, fly_run
-from lab.campaign.spec import BaseMission, Campaign
+from lab.campaign.types import BaseMission, Campaign
 
 WRITE_EVERY_S = 2.0
 

@@ -14,7 +14,7 @@ from gcs.mission.options import RunOptions
 from lab.campaign.metrics import failed_row, mission_row
 from lab.campaign.planner_keys import mission_with
 from lab.campaign.run import RunSpec, failure_text, stamped
-from lab.campaign.spec import BaseMission
+from lab.campaign.types import BaseMission
 from lab.lockstep import install
 
 PLANNER = "planner."

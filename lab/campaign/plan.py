@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from lab.campaign.run import RunSpec, make_run
-from lab.campaign.spec import Campaign, Range
+from lab.campaign.types import Campaign, Range
 
 
 def draw(axis: Range | tuple[Any, ...], rng: np.random.Generator) -> Any:

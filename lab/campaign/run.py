@@ -18,8 +18,8 @@ from gcs.config import config_from_table
 from gcs.flight import FlightPlan
 from gcs.station.session import SessionOptions
 from lab.campaign.metrics import failed_row, flown_row
-from lab.campaign.spec import BaseFlight, BaseMission
 from lab.campaign.tables import set_dotted, station_table, world_table
+from lab.campaign.types import BaseFlight, BaseMission
 from lab.lockstep import install
 from sitl import native
 

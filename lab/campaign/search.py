@@ -24,8 +24,8 @@ from lab.campaign.pool import need, run_all
 from lab.campaign.progress import Progress
 from lab.campaign.results import RESULTS_NAME, read_results
 from lab.campaign.run import RunSpec, fly_run, make_run
-from lab.campaign.spec import BaseFlight, Campaign, Range
 from lab.campaign.tables import dumps, set_dotted, station_table
+from lab.campaign.types import BaseFlight, Campaign, Range
 
 BEST_NAME = "best_station.toml"
 HISTORY_NAME = "search_history.png"

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from lab.campaign.results import mission_summary_table
 from lab.campaign.run import RunSpec, fly_run, make_run
-from lab.campaign.spec import BaseFlight
+from lab.campaign.types import BaseFlight
 from sitl import native
 
 
