@@ -87,7 +87,11 @@ class ReynoldsPlanner:
 
     def final_targets_n(self) -> dict[int, Vec3]:
         """Each vehicle's target."""
-        return {v: tuple(self._targets[v].tolist()) for v in self.ids}  # type: ignore[misc]
+        out: dict[int, Vec3] = {}
+        for v in self.ids:
+            x, y, z = (float(c) for c in self._targets[v])
+            out[v] = (x, y, z)
+        return out
 
     def start_positions_n(self, leader_start_n: Vec3) -> dict[int, Vec3]:
         """The same starting layout as the triangular flock."""
