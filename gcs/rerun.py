@@ -31,7 +31,8 @@ from gcs import params_json, topics
 from gcs.config import StationConfig, _build
 from gcs.control.altitude_controller import AltControlOutput
 from gcs.control.throttle_curve import ThrottleCurve
-from gcs.core import FlightCore, TickInputs, TickRecord
+from gcs.core.flight_core import FlightCore
+from gcs.core.inputs import TickInputs, TickRecord
 from gcs.errors import UsageError
 from gcs.estimation import AltEstimate
 from gcs.station.types import StationSetup

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from firmware_link.records import Attitude, Imu, Rangefinder
-from gcs.estimation.catch_up import CatchUp, TickInputs, average_imu
+from gcs.estimation.catch_up import CatchUp, EstimatorTick, average_imu
 from gcs.estimation.control import (
     control_correct,
     control_follow,
@@ -201,7 +201,7 @@ class AltEstimator(SonarReadings):
         `command_acc_mps2`: the vertical acceleration the last stick command sent asks of the
         vehicle (None when the station does not fly the throttle)."""
         samples = () if imus is None else (imus,) if isinstance(imus, Imu) else tuple(imus)
-        inputs = TickInputs(t_s, samples, tuple(sonars), attitude, at_rest, baro_alt_m,
+        inputs = EstimatorTick(t_s, samples, tuple(sonars), attitude, at_rest, baro_alt_m,
                             command_acc_mps2)
         est = self._catch_up.tick(self, inputs, self._run_tick)
         assert isinstance(est, AltEstimate)
@@ -230,7 +230,7 @@ class AltEstimator(SonarReadings):
         assert isinstance(state, dict)
         vars(self).update({k: _copied(v) for k, v in state.items()})
 
-    def _run_tick(self, tick: TickInputs) -> AltEstimate:
+    def _run_tick(self, tick: EstimatorTick) -> AltEstimate:
         """`update` with the tick's IMU samples averaged and its first sonar reading, then
         each later reading.
 

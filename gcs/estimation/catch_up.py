@@ -48,8 +48,10 @@ def average_imu(imus: Sequence[Imu]) -> Imu | None:
 
 
 @dataclass(frozen=True, slots=True)
-class TickInputs:
-    """What one control tick gives the estimator."""
+class EstimatorTick:
+    """What one control tick gives the estimator (the flight core's `TickInputs` as the filter
+    takes them: IMU samples, sonar readings, the newest attitude, and what the core derived),
+    kept so a late burst can run the ticks again."""
 
     t_s: float
     imus: tuple[Imu, ...]
@@ -78,7 +80,7 @@ class CatchUpParams:
 
 @dataclass(frozen=True, slots=True)
 class _Kept:
-    inputs: TickInputs
+    inputs: EstimatorTick
     state: object  # the estimator's state before this tick
 
 
@@ -97,8 +99,8 @@ class CatchUp:
         # can never be the window's least again, so it is dropped when that one comes
         self._offsets: deque[tuple[float, float]] = deque()
 
-    def tick(self, est: Restorable, inputs: TickInputs,
-             step: Callable[[TickInputs], object]) -> object:
+    def tick(self, est: Restorable, inputs: EstimatorTick,
+             step: Callable[[EstimatorTick], object]) -> object:
         """Run `step` on this tick's inputs, or on the kept ticks again from the earliest one
         that the late samples were due at; returns the last step's result."""
         p = self.params
@@ -124,7 +126,7 @@ class CatchUp:
         self._learn_offset(inputs)
         return result
 
-    def _without_repeats(self, inputs: TickInputs) -> TickInputs:
+    def _without_repeats(self, inputs: EstimatorTick) -> EstimatorTick:
         """The tick's inputs without the IMU samples already taken."""
         taken, cutoff = self._taken, inputs.t_s - self.params.max_window_s
         while taken:
@@ -142,7 +144,7 @@ class CatchUp:
             kept.append(imu)
         return inputs if len(kept) == len(inputs.imus) else replace(inputs, imus=tuple(kept))
 
-    def _replay_from(self, inputs: TickInputs, offset_s: float | None) -> int | None:
+    def _replay_from(self, inputs: EstimatorTick, offset_s: float | None) -> int | None:
         """Index of the kept tick to run again from, None when this tick's samples are on time."""
         if offset_s is None or not inputs.imus or not self._kept:
             return None
@@ -158,7 +160,7 @@ class CatchUp:
             k -= 1
         return k + 1
 
-    def _learn_offset(self, inputs: TickInputs) -> None:
+    def _learn_offset(self, inputs: EstimatorTick) -> None:
         if not inputs.imus or inputs.imus[-1].time_usec <= 0:
             return
         last = inputs.imus[-1]
@@ -179,8 +181,8 @@ class CatchUp:
         return self._offsets[0][1] if self._offsets else None
 
 
-def _redistributed(earlier: list[TickInputs], now: TickInputs,
-                   offset_s: float) -> list[TickInputs]:
+def _redistributed(earlier: list[EstimatorTick], now: EstimatorTick,
+                   offset_s: float) -> list[EstimatorTick]:
     """The earlier ticks and this one, each with this tick's samples that were due at it."""
     ticks = [*earlier, now]
     times = [t.t_s for t in ticks]
@@ -189,7 +191,7 @@ def _redistributed(earlier: list[TickInputs], now: TickInputs,
     first, last = due[0], due[-1]
     m = len(now.sonars)
     sonar_due = [last if m == 1 else first + (last - first) * (j + 1) / m for j in range(m)]
-    out: list[TickInputs] = []
+    out: list[EstimatorTick] = []
     lo = -float("inf")
     for k, t in enumerate(ticks):
         hi = t.t_s if k < len(ticks) - 1 else float("inf")

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from gcs import topics
-from gcs.core import TickInputs, TickOutputs, TickRecord
+from gcs.core.inputs import TickInputs, TickRecord
+from gcs.core.outputs import TickOutputs
 from gcs.station.loop import TickTiming
 from gcs.station.types import LoopSample, Recorder
 

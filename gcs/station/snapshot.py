@@ -14,7 +14,7 @@ from firmware_link.records import (
     SimTruth,
     TelemetryRecord,
 )
-from gcs.core import FlightCore
+from gcs.core.flight_core import FlightCore
 from gcs.station.intents import STICK_MIN_US
 from gcs.station.loop import LoopStats
 from gcs.station.types import StationEvent, StationSnapshot, control_mode

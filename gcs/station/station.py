@@ -38,8 +38,8 @@ from gcs import params_json, topics
 from gcs.clock import Clock, MonotonicClock
 from gcs.config import StationConfig
 from gcs.control.throttle_curve import ThrottleCurve
-from gcs.core import FlightCore, TickInputs
-from gcs.core.inputs import NEVER_S
+from gcs.core.flight_core import FlightCore
+from gcs.core.inputs import NEVER_S, TickInputs
 from gcs.core.landing import may_leave, must_land
 from gcs.estimation import AltEstimator
 from gcs.station.execute import send_decision

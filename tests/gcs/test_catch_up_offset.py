@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from firmware_link.records import Imu
-from gcs.estimation.catch_up import CatchUp, CatchUpParams, TickInputs
+from gcs.estimation.catch_up import CatchUp, CatchUpParams, EstimatorTick
 
 TICK_S = 0.025
 
@@ -21,10 +21,10 @@ class _Still:
         pass
 
 
-def _tick(t_s: float, delay_s: float) -> TickInputs:
+def _tick(t_s: float, delay_s: float) -> EstimatorTick:
     sample_t = t_s - delay_s
     imu = Imu(t_s, 1, (0.0, 0.0, -9.81), (0.0, 0.0, 0.0), "RAW_IMU", round(sample_t * 1e6))
-    return TickInputs(t_s, (imu,), (), None, False, None)
+    return EstimatorTick(t_s, (imu,), (), None, False, None)
 
 
 def test_the_offset_is_the_least_delay_of_the_window_as_it_slides() -> None:

@@ -12,10 +12,11 @@ from gcs.cli import build_parser
 from gcs.commands.fly import fly
 from gcs.config import StationConfig
 from gcs.control.throttle_curve import ThrottleCurve
-from gcs.core import FlightCore, TickInputs, TickOutputs
-from gcs.core.inputs import NEVER_S
+from gcs.core.flight_core import FlightCore
+from gcs.core.inputs import NEVER_S, TickInputs
 from gcs.core.landing import lands_on_death, may_leave, must_land
 from gcs.core.link_down import LinkDownClock
+from gcs.core.outputs import TickOutputs
 from gcs.rerun import load_flight
 from gcs.supervisor import (
     Intent,

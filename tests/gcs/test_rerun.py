@@ -16,7 +16,7 @@ from gcs import params_json, topics
 from gcs.cli import main
 from gcs.clock import SimClock
 from gcs.config import EstimatorKind, StationConfig
-from gcs.core import TickRecord
+from gcs.core.inputs import TickRecord
 from gcs.errors import UsageError
 from gcs.rerun import (
     RerunReport,
