@@ -15,10 +15,10 @@ import hashlib
 from collections.abc import Callable
 from typing import Any
 
+from firmware_link.byte_transport import ByteTransport, TransportClosed
 from firmware_link.frame_reader import FrameReader
 from firmware_link.protocol import WireVersion, frame_overhead_bytes, mavlink, mavlink1
 from firmware_link.stats import LinkStats, StatsTally
-from firmware_link.transport import ByteTransport, TransportClosed
 from firmware_link.tx_queue import TxQueue
 
 RawTap = Callable[[str, float, bytes], None]

@@ -17,6 +17,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from firmware_link.byte_transport import TransportClosed
 from firmware_link.connection import ConnectionSpec
 from firmware_link.convert import RecordConverter, text_field
 from firmware_link.firmware import FirmwareEvidence, FirmwareInfo, decide_firmware
@@ -33,7 +34,6 @@ from firmware_link.records import (
 )
 from firmware_link.stats import LinkStats
 from firmware_link.streams import DataStream, StreamPlan
-from firmware_link.transport import TransportClosed
 from firmware_link.upkeep import TransportUpkeep
 
 MAV_TYPE_GCS = 6

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 from typing import Protocol
 
+from firmware_link.byte_transport import READ_BUDGET_BYTES, TransportClosed
 from firmware_link.connection import ConnectionSpec
 from firmware_link.errors import LinkError
-from firmware_link.transport import READ_BUDGET_BYTES, TransportClosed
 
 SCHEME = "mem"
 

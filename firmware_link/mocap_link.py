@@ -11,13 +11,14 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from firmware_link.byte_transport import TransportClosed
 from firmware_link.connection import ConnectionSpec, parse_connection_string
 from firmware_link.convert import RecordConverter
 from firmware_link.frames import FrameEndpoint, RawTap
 from firmware_link.protocol import WireVersion
 from firmware_link.records import MocapPose
 from firmware_link.stats import LinkStats
-from firmware_link.transport import TransportClosed, open_transport
+from firmware_link.transport import open_transport
 
 MAV_TYPE_GCS = 6
 MAV_AUTOPILOT_INVALID = 8

@@ -16,40 +16,20 @@ import os
 import select
 import socket
 from collections.abc import Callable
-from typing import Protocol
 
 import serial
 
+from firmware_link.byte_transport import READ_BUDGET_BYTES, ByteTransport, TransportClosed
 from firmware_link.connection import ConnectionSpec, Transport
 from firmware_link.errors import LinkError
 
 READ_CHUNK_BYTES = 65536
-# One poll() parses at most this much (≈ 10 ms of pymavlink work); a backlog after a stall is
-# worked off over the next ticks instead of stalling one of them.
-READ_BUDGET_BYTES = 16384
 # The kernel's own send buffer is a queue the link cannot see or trim: Linux lets a TCP socket's
 # grow to megabytes, seconds of stale overrides behind a slow peer. A small one keeps the
 # backlog in the link's queue, where an override replaces the one before it.
 TCP_SEND_BUFFER_BYTES = 16384
 # errno values of a write that would block: backpressure, not an error
 _WOULD_BLOCK = (errno.EAGAIN, errno.EWOULDBLOCK, errno.EINTR)
-
-
-class TransportClosed(LinkError):
-    """The peer went away (TCP EOF, serial device gone)."""
-
-
-class ByteTransport(Protocol):
-    """What the link needs from a transport."""
-
-    def read(self, max_bytes: int = READ_BUDGET_BYTES) -> bytes: ...
-    def write(self, data: bytes | memoryview) -> int: ...
-    def wait_readable(self, timeout_s: float) -> None: ...
-    def wait_writable(self, timeout_s: float) -> None: ...
-    @property
-    def has_peer(self) -> bool: ...
-    def close(self) -> None: ...
-    def fileno(self) -> int: ...
 
 
 def _wait(fd: int, timeout_s: float) -> None:

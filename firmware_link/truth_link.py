@@ -14,11 +14,12 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from firmware_link.byte_transport import TransportClosed
 from firmware_link.connection import ConnectionSpec, parse_connection_string
 from firmware_link.frames import FrameEndpoint
 from firmware_link.protocol import WireVersion
 from firmware_link.records import Vec3
-from firmware_link.transport import TransportClosed, open_transport
+from firmware_link.transport import open_transport
 
 TRUTH_SYSID = 201
 MAV_TYPE_GCS = 6

@@ -12,10 +12,11 @@ import socket
 from collections.abc import Callable
 from typing import Any
 
+from firmware_link.byte_transport import ByteTransport
 from firmware_link.connection import ConnectionSpec, Transport
 from firmware_link.errors import LinkError
 from firmware_link.records import LinkEventKind
-from firmware_link.transport import ByteTransport, SerialTransport, TcpTransport
+from firmware_link.transport import SerialTransport, TcpTransport
 
 
 class TransportUpkeep:

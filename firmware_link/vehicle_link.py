@@ -24,6 +24,7 @@ from typing import Any
 
 from firmware_link.arming import ArmingAndModes, MavResult
 from firmware_link.bring_up import StreamBringUp
+from firmware_link.byte_transport import ByteTransport, TransportClosed
 from firmware_link.connection import ConnectionSpec, parse_connection_string
 from firmware_link.dialect import MAVLINK1_CANNOT_SIGN
 from firmware_link.errors import LinkError, LinkUsageError
@@ -37,7 +38,7 @@ from firmware_link.protocol import WireVersion
 from firmware_link.pwm import clamp_pwm_us
 from firmware_link.records import LinkEventKind
 from firmware_link.signing import KEY_BYTES, signing_timestamp
-from firmware_link.transport import ByteTransport, TransportClosed, open_transport
+from firmware_link.transport import open_transport
 
 SIGNING_ON = "MAVLink 2 signing on: outgoing frames signed, unsigned frames refused"
 CLOSE_FLUSH_S = 0.5  # close() gives the override release this long to get out

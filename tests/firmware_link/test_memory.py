@@ -5,9 +5,10 @@ from __future__ import annotations
 import pytest
 
 from firmware_link import memory
+from firmware_link.byte_transport import TransportClosed
 from firmware_link.connection import Transport, parse_connection_string
 from firmware_link.errors import LinkError, LinkUsageError
-from firmware_link.transport import TransportClosed, open_transport
+from firmware_link.transport import open_transport
 
 
 class Pipe:
