@@ -301,7 +301,8 @@ def parse_gains(spec: str) -> dict[str, Any]:
 
 def apply_overrides(config: StationConfig, table: Mapping[str, Any]) -> StationConfig:
     """`config` with the override table applied (unknown keys, wrong types: UsageError)."""
-    return _build(config, dict(table), "--gains ")
+    built: StationConfig = _build(config, dict(table), "--gains ")
+    return built
 
 
 def changed_parameters(before: Any, after: Any, prefix: str = "") -> tuple[str, ...]:

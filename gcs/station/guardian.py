@@ -72,7 +72,7 @@ class Guardian:
         self._sock = sock
         self._proc = proc
         self._sent_link: int | None = None
-        self._sent_peer: tuple | None = None
+        self._sent_peer: tuple[object, ...] | None = None
         self._sent_state: tuple[bool, int, str] | None = None
         self._gone = False
 
@@ -147,7 +147,7 @@ class Guardian:
                 and self._send(("link", peer), fd)):
             self._sent_link, self._sent_peer = generation, peer
 
-    def _send(self, message: tuple, fd: int | None = None) -> bool:
+    def _send(self, message: tuple[object, ...], fd: int | None = None) -> bool:
         data = pickle.dumps(message)
         try:
             if fd is None:
@@ -168,7 +168,7 @@ def _say(text: str) -> None:
     print(f"guardian: {text}", file=sys.stderr, flush=True)
 
 
-def take_over(setup: GuardianSetup, fd: int, peer: tuple | None, throttle_us: int,
+def take_over(setup: GuardianSetup, fd: int, peer: tuple[object, ...] | None, throttle_us: int,
               state: str) -> int:
     """Land the vehicle of a station that died flying it; the exit status."""
     from firmware_link.transport import adopt_transport
@@ -201,7 +201,7 @@ def main(argv: list[str]) -> int:
 
     setup: GuardianSetup | None = None
     fd: int | None = None
-    peer: tuple | None = None
+    peer: tuple[object, ...] | None = None
     flying, throttle_us, state = False, 1000, "?"
     while True:
         try:
