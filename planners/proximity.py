@@ -149,7 +149,7 @@ def _perpendiculars(axis: Vec3) -> tuple[Vec3, Vec3]:
     u = np.cross(a, helper)
     u /= np.linalg.norm(u)
     v = np.cross(a, u)
-    return (tuple(u.tolist()), tuple(v.tolist()))  # type: ignore[return-value]
+    return (tuple(u.tolist()), tuple(v.tolist()))
 
 
 def cone_rays_b(facing: Facing, params: ProximityParams) -> list[Vec3]:

@@ -96,7 +96,7 @@ def _build(cls: type, table: dict[str, Any], path: Path, nested: dict[str, type]
         if field_name in sub:
             # the planner's own defaults for the nested table (the flock's leader keeps off
             # farther than EPBHA alone), with the mission's keys over them
-            default = next((f.default_factory() for f in dataclasses.fields(cls)  # type: ignore[misc]
+            default = next((f.default_factory() for f in dataclasses.fields(cls)
                             if f.name == field_name and callable(f.default_factory)),
                            sub_cls())
             try:

@@ -81,7 +81,8 @@ class MissionReport:
         }
         for k, v in self.metrics.items():
             base.setdefault(k, v)
-        return _clean(base)
+        cleaned: dict[str, Any] = _clean(base)
+        return cleaned
 
     def to_json(self) -> str:
         """One line of JSON."""

@@ -183,13 +183,14 @@ class Formation:
         par = self.parent(index)
         if par is None:
             return np.zeros(2)
-        return self.offsets_f[index] - self.offsets_f[par]
+        return np.asarray(self.offsets_f[index] - self.offsets_f[par])
 
     def slot_n(
         self, index: int, leader_xy_n: np.ndarray, forward_xy_n: np.ndarray
     ) -> np.ndarray:
         """NED horizontal slot of ``index`` given its own leader's position and the team heading."""
-        return leader_xy_n + rotate_f_to_n(self.offset_from_parent_f(index), forward_xy_n)
+        slot = leader_xy_n + rotate_f_to_n(self.offset_from_parent_f(index), forward_xy_n)
+        return np.asarray(slot)
 
 
 def rotate_f_to_n(vec_f: np.ndarray, forward_xy_n: np.ndarray) -> np.ndarray:

@@ -168,7 +168,7 @@ class RadiationEvidence:
                 continue
             if any(np.linalg.norm(pos[k] - r) < p.hotspot_separation_m for r in self.rejected):
                 continue
-            return pos[k]
+            return np.asarray(pos[k])
         return self.orphan_region_peak()
 
     def orphan_region_peak(self) -> np.ndarray | None:
@@ -197,7 +197,7 @@ class RadiationEvidence:
             inside = shapely.contains_xy(part.buffer(0.25), pos[:, 0], pos[:, 1])
             strong = inside & (cps > self.level * p.layer_ratio)
             if strong.any():
-                return pos[int(np.argmax(np.where(strong, cps, -np.inf)))]
+                return np.asarray(pos[int(np.argmax(np.where(strong, cps, -np.inf)))])
         return None
 
     def crossing_radius(
@@ -238,7 +238,7 @@ class RadiationEvidence:
             fitted = model
 
             def log_i(q: np.ndarray) -> np.ndarray:
-                return np.log(fitted.intensity(q[:, 0], q[:, 1]))
+                return np.asarray(np.log(fitted.intensity(q[:, 0], q[:, 1])))
 
             def grad_log_i(q: np.ndarray) -> np.ndarray:
                 h = np.array([[1e-3, 0.0], [0.0, 1e-3]])

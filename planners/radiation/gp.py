@@ -35,7 +35,7 @@ def se_kernel(a: np.ndarray, b: np.ndarray, hyper: GpHyper) -> np.ndarray:
     """Anisotropic squared-exponential covariance between point sets a (n, 2) and b (m, 2)."""
     scale = np.array([hyper.lengthscale_x_m, hyper.lengthscale_y_m])
     da = a[:, None, :] / scale - b[None, :, :] / scale
-    return hyper.signal_std**2 * np.exp(-0.5 * np.sum(da * da, axis=-1))
+    return np.asarray(hyper.signal_std**2 * np.exp(-0.5 * np.sum(da * da, axis=-1)))
 
 
 def _cholesky(k: np.ndarray) -> np.ndarray:
@@ -116,7 +116,7 @@ class GaussianProcess:
     def predict_mean(self, xq: np.ndarray) -> np.ndarray:
         """Posterior mean only (eq. 10.15), cheaper than :meth:`predict`."""
         xq = np.asarray(xq, dtype=float).reshape(-1, 2)
-        return self.prior_mean + se_kernel(xq, self.x_train, self.hyper) @ self._alpha
+        return np.asarray(self.prior_mean + se_kernel(xq, self.x_train, self.hyper) @ self._alpha)
 
     def predict(self, xq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Posterior mean (eq. 10.15) and latent variance (eq. 10.16) at points xq (m, 2)."""
@@ -152,7 +152,7 @@ class GaussianProcess:
         k_qs = se_kernel(xq, self.x_train, self.hyper)
         scale_sq = np.array([self.hyper.lengthscale_x_m, self.hyper.lengthscale_y_m]) ** 2
         diff = self.x_train[None, :, :] - xq[:, None, :]
-        return np.einsum("ms,msd->md", k_qs * self._alpha[None, :], diff) / scale_sq
+        return np.asarray(np.einsum("ms,msd->md", k_qs * self._alpha[None, :], diff) / scale_sq)
 
     def log_marginal_likelihood(self) -> float:
         """log p(y | x, hyper) of the training data."""

@@ -137,7 +137,7 @@ def _gap(box_lo: float, box_hi: float, lo: np.ndarray, hi: np.ndarray) -> np.nda
 
 
 def _dist_sq(gaps: list[np.ndarray]) -> np.ndarray:
-    return (
+    return np.asarray(
         gaps[0][:, None, None] ** 2 + gaps[1][None, :, None] ** 2 + gaps[2][None, None, :] ** 2
     )
 
