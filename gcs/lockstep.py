@@ -107,10 +107,6 @@ def open_simulator(options: LockstepOptions) -> LockstepSimulator:
     return _openers[-1](options)
 
 
-BundledLockstep = open_simulator
-"""The name `LockstepSession` opens its simulator by."""
-
-
 class SteppedTruth:
     """A vehicle's truth reports, collected on the station's tick instead of by a thread (as
     `TruthRecorder` does over TCP): in lockstep a thread would read at wall-clock moments."""

@@ -2,9 +2,10 @@
 
 Everything after the SITL's start is the session a pilot gets: a recorder per vehicle, the link
 opened and brought up, the throttle curve read, the pre-flight checks, motion capture and a
-`Station`. Only what differs is here: the SITL is `gcs.lockstep.BundledLockstep` instead of a
-subprocess, the clock is its `LockstepClock`, the truth reports are taken on the station's tick,
-and the stations are run by `run_tick()` (see `tick`) instead of loop threads.
+`Station`. Only what differs is here: the SITL is the one `gcs.lockstep.open_simulator` gives
+(the bundled SITL in this process, `lab.lockstep`) instead of a subprocess, the clock is its
+`LockstepClock`, the truth reports are taken on the station's tick, and the stations are run by
+`run_tick()` (see `tick`) instead of loop threads.
 
 A campaign may hand over an already loaded world (its noise and floor varied) and a station
 configuration object instead of files; a pilot's `fly --lockstep` passes files as over TCP.
@@ -21,7 +22,7 @@ from firmware_link.truth_link import TruthLink
 from gcs.config import StationConfig, load_config
 from gcs.core.landing import may_leave, must_land
 from gcs.errors import UsageError
-from gcs.lockstep import BundledLockstep, LockstepOptions, SteppedTruth, TeamClock
+from gcs.lockstep import LockstepOptions, SteppedTruth, TeamClock, open_simulator
 from gcs.station.session import SCORED_COMMANDS, SessionOptions, StationSession
 
 LOCKSTEP_EPOCH_NS = 946_684_800 * 10**9
@@ -50,7 +51,7 @@ class LockstepSession(StationSession):
         self._config = config
         self._noise = noise
         truth = options.command in SCORED_COMMANDS or options.metadata.get("truth") == "on"
-        self.sitl = BundledLockstep(LockstepOptions(
+        self.sitl = open_simulator(LockstepOptions(
             profile=options.profile, world=self._world, vehicles=max(options.sysids),
             seed=options.seed or 0, noise=noise, truth=truth, signing_key=None, faults=faults))
         super().__init__(options)
