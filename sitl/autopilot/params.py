@@ -77,6 +77,7 @@ class Key(enum.Enum):
     THR_MIN = enum.auto()
     THR_DZ = enum.auto()
     PILOT_VELZ_MAX = enum.auto()
+    PILOT_SPEED_DN = enum.auto()  # 4.x; 0 = the up speed
     ANGLE_MAX = enum.auto()
     FS_GCS_ENABLE = enum.auto()
     FS_GCS_TIMEOUT_S = enum.auto()
@@ -171,6 +172,7 @@ _COPTER4_KEYS: dict[Key, tuple[str, float]] = {
     Key.THR_MIN: ("MOT_SPIN_MIN", 1.0),
     Key.THR_DZ: ("THR_DZ", 1.0),
     Key.PILOT_VELZ_MAX: ("PILOT_SPEED_UP", 1.0),
+    Key.PILOT_SPEED_DN: ("PILOT_SPEED_DN", 1.0),
     Key.ANGLE_MAX: ("ANGLE_MAX", 1.0),
     Key.FS_GCS_ENABLE: ("FS_GCS_ENABLE", 1.0),
     Key.FS_GCS_TIMEOUT_S: ("FS_GCS_TIMEOUT", 1.0),
@@ -200,6 +202,7 @@ FIXED_VALUES: dict[Profile, dict[Key, float]] = {
         Key.DISARM_DELAY_S: 15.0,
         Key.RC_OVERRIDE_TIME: 0.0,
         Key.SPOOL_TIME_S: 0.0,
+        Key.PILOT_SPEED_DN: 0.0,  # 3.2.1 descends by PILOT_VELZ_MAX's own formula
     },
     # 4.x estimates height with its EKF; this SITL keeps the 3.2.1 filter and surface tracking
     # gain on copter4 too.
