@@ -12,7 +12,12 @@ from collections.abc import Sequence
 
 from sitl.autopilot import arming
 from sitl.autopilot.ahrs import GRAVITY_MSS, Ahrs
-from sitl.autopilot.alt_hold import AltitudeController, SurfaceTracker
+from sitl.autopilot.alt_hold import (
+    SHAPE_APM25,
+    SHAPE_COPTER4,
+    AltitudeController,
+    SurfaceTracker,
+)
 from sitl.autopilot.arming import CommandResult, MavResult, Severity
 from sitl.autopilot.attitude import AttitudeController
 from sitl.autopilot.failsafe import BatteryWatch, GcsWatch, RadioWatch
@@ -22,6 +27,7 @@ from sitl.autopilot.inertial_nav import InertialNavZ
 from sitl.autopilot.land_detector import LandDetector
 from sitl.autopilot.mixer import MixerOutput, mix_plus
 from sitl.autopilot.params import FS_GCS_TIMEOUT_RANGE_S, Key, ParamStore
+from sitl.autopilot.pilot_climb import climb_rate_apm25, climb_rate_copter4
 from sitl.autopilot.profile import (
     KNOWN_UNSUPPORTED_MODES,
     AutopilotOptions,
@@ -32,14 +38,11 @@ from sitl.autopilot.radio import Radio
 from sitl.autopilot.rtl import Rtl, RtlParams
 from sitl.autopilot.spool import Spool
 from sitl.autopilot.state import AutopilotState, SensorSample, SystemStatus
-from sitl.autopilot.throttle_curve import (
-    climb_rate_from_stick,
-    throttle_apm25,
-    throttle_copter4,
-)
+from sitl.autopilot.throttle_curve import throttle_apm25, throttle_copter4
 
 GYRO_CAL_S = 1.0  # boot-time gyro calibration of the attitude estimator
 LAND_PAUSE_S = 4.0  # LAND_WITH_DELAY_MS of both firmwares
+SURFTRAK_TC_S = 1.0  # 4.x SURFTRAK_TC
 
 
 class Autopilot:
@@ -64,9 +67,14 @@ class Autopilot:
         self.radio = Radio(profile, self.options.rc_input)
         self.rtl = Rtl()
         self.ahrs = Ahrs()
-        self.inav = InertialNavZ(self.gains.inav_tc_z_s)
+        # 3.2.1's inertial nav compares the baro with its estimate 150 ms back, hard-coded (its
+        # fixture's overshoots need that); 4.x's EKF waits EK3_HGT_DELAY 60 ms (at 150 ms,
+        # 4.x's stick steps ring and settle 10 % slow against its fixture)
+        baro_delay_s = 0.15 if profile is Profile.APM25 else 0.06
+        self.inav = InertialNavZ(self.gains.inav_tc_z_s, delay_s=baro_delay_s)
         self.attitude = AttitudeController(self.gains)
-        self.alt_ctrl = AltitudeController(self.gains, hover_throttle)
+        shape = SHAPE_APM25 if profile is Profile.APM25 else SHAPE_COPTER4
+        self.alt_ctrl = AltitudeController(self.gains, hover_throttle, shape)
         self.surface = SurfaceTracker()
         self.land = LandDetector(climb_max_ms=0.4 if profile is Profile.APM25 else 1.0)
         self.gcs = GcsWatch()
@@ -119,6 +127,7 @@ class Autopilot:
             land_speed_cms=k(Key.LAND_SPEED),
             home_distance_m=self.options.home_distance_m,
         )
+        self._speed_dn_cms = k(Key.PILOT_SPEED_DN)
         self.attitude.set_gains(self.gains)
         self.alt_ctrl.set_gains(self.gains)
         self.inav.tc_z_s = self.gains.inav_tc_z_s
@@ -149,8 +158,14 @@ class Autopilot:
 
     def _pilot_climb_cms(self) -> float:
         g = self.gains
-        return climb_rate_from_stick(
-            self.throttle_stick(), g.thr_dz, g.pilot_velz_max_cms, g.pilot_velz_max_cms
+        pwm = self.radio.channel(2)
+        if self.profile is Profile.APM25:
+            return climb_rate_apm25(
+                pwm, self._dz_us[2], round(g.thr_dz), round(self._thr_min_param),
+                round(g.pilot_velz_max_cms),
+            )
+        return climb_rate_copter4(
+            pwm, self._dz_us[2], round(g.thr_dz), g.pilot_velz_max_cms, self._speed_dn_cms
         )
 
     # ---- GCS-facing commands --------------------------------------------------------------
@@ -412,13 +427,18 @@ class Autopilot:
             if not st.armed or self.land.landed:
                 self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
                 return 0.0, t_roll, t_pitch, yaw_rate
-        climb = self.surface.climb_rate(
-            climb,
-            dt_s,
-            self.gains.rng_gain,
-            self.alt_ctrl.target_alt_cm,
-            self.inav.alt_m * 100.0,
-        )
+        if c4:
+            self.alt_ctrl.target_alt_cm += self.surface.terrain_shift(
+                self.inav.alt_m * 100.0, dt_s, SURFTRAK_TC_S
+            )
+        else:
+            climb = self.surface.climb_rate(
+                climb,
+                dt_s,
+                self.gains.rng_gain,
+                self.alt_ctrl.target_alt_cm,
+                self.inav.alt_m * 100.0,
+            )
         out = self.alt_ctrl.update(
             climb,
             self.inav.alt_m * 100.0,

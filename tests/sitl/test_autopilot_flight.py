@@ -326,8 +326,10 @@ def test_alt_hold_takes_off_on_the_stick_holds_and_comes_back_down(profile: Prof
     pilot.fly(0.3)
     ack = arm(gcs, pilot)
     assert ack.result == 0
-    pilot.sticks[2] = 1800  # climb at about 1.2 m/s (copter4 spools up for 0.5 s first)
-    climb_s = 1.5 if profile is Profile.APM25 else 2.0
+    # climb: 1.1 m/s on copter4 (which spools up for 0.5 s first); 1.37 m/s on apm25, whose
+    # climb rate lags its target by ≈ 1 s (no feed-forward; althold-steps fixture)
+    pilot.sticks[2] = 1800
+    climb_s = 2.2 if profile is Profile.APM25 else 2.0
     assert truth_alt(gcs, pilot.fly(climb_s)) > 1.2
     pilot.sticks[2] = HOVER_STICK_US
     pilot.fly(4.0)  # the climb overshoots the held height by up to 0.8 m and comes back

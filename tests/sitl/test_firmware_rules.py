@@ -8,6 +8,7 @@ import pytest
 
 from sitl.autopilot import AutopilotOptions, FlightMode, Profile
 from sitl.autopilot.profile import RcInput
+from sitl.autopilot.rangefinder import firmware_reading
 from sitl.link import telemetry as tm
 from sitl.simulation import Simulation
 from sitl.world import WorldError, load_world
@@ -38,23 +39,38 @@ def _texts(gcs: MemoryGcs, msgs: list) -> list[str]:
 
 
 # ---- 1. rangefinder ------------------------------------------------------------------------
+# (true range, cm sent) as the fixtures show: 4.7 whole centimetres; 3.2.1's analog sonar in
+# ≈ 5.9 cm ADC steps, truncated. Both send readings below RNGFND min (0.15 m here), 0 with no
+# echo; the driver marks those below the minimum out of range and the autopilot ignores them.
+RANGE_CASES = {
+    Profile.COPTER4: ((1.23456, 123, True), (0.5049, 50, True), (0.15, 15, False),
+                      (0.012, 1, False), (None, 0, False)),
+    Profile.APM25: ((1.23456, 117, True), (0.5049, 47, True), (0.15, 10, False),
+                    (0.012, 0, False), (None, 0, False)),
+}  # fmt: skip
+
+
 @pytest.mark.parametrize("profile", [Profile.APM25, Profile.COPTER4])
-def test_rangefinder_reports_whole_centimetres_and_zero_outside_its_range(
+def test_rangefinder_reports_what_the_driver_reads_below_its_minimum_too(
     profile: Profile,
 ) -> None:
     sim = Simulation(big_room(), profile, 1, seed=3)
     view = sim.vehicle(1).view
-    for d, cm in ((1.23456, 123), (0.5049, 50), (0.012, 0), (4.2, 0), (None, 0)):
-        view.cache.sonar_m = d
+    name = "RNGFND_MIN_CM" if profile is Profile.APM25 else "RNGFND1_MIN"
+    assert view.params.get(name) == pytest.approx(20.0 if profile is Profile.APM25 else 0.2)
+    for d, cm, valid in RANGE_CASES[profile]:
+        reading = firmware_reading(view.params, d)
+        assert (reading.distance_cm, reading.valid) == (cm, valid), d
+        view.cache.rangefinder = reading
         assert tm.rangefinder_cm(view) == cm
         rf = tm.rangefinder(view)
         assert rf.distance == pytest.approx(cm / 100.0)
         assert tm.distance_sensor_down(view).current_distance == cm
-    # the owner's RNGFND minimum applies too: below it the reading is 0
-    name = "RNGFND_MIN_CM" if profile is Profile.APM25 else "RNGFND1_MIN"
-    view.params.set(name, 20.0 if profile is Profile.APM25 else 0.2)
-    view.cache.sonar_m = 0.15
-    assert tm.rangefinder_cm(view) == 0
+        # 3.2.1's voltage field is the ADC's whole millivolts (fixture: 4 mV for 4 cm)
+        assert rf.voltage == pytest.approx(reading.voltage_v)
+    assert firmware_reading(view.params, 0.5049).voltage_v == (
+        pytest.approx(0.039) if profile is Profile.APM25 else 0.0
+    )
 
 
 @pytest.mark.parametrize("profile", [Profile.APM25, Profile.COPTER4])
