@@ -41,6 +41,7 @@ throttle is anything.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -54,6 +55,7 @@ APM25_GCS_TIMEOUT_S = 5.0  # 3.2.1's FS_GCS_TIMEOUT_MS, a compile-time constant
 APM25_RADIO_TIMEOUT_S = 2.0  # 3.2.1: no receiver, radio failsafe 2 s after the last override
 LAND_PAUSE_S = 4.0  # 4.x: a failsafe's Land holds this long before it descends
 FS_GCS_TIMEOUT_MIN_S = 2.0  # 4.x FS_GCS_TIMEOUT's lower bound
+RC_OVERRIDE_TIME_DEFAULT_S = 3.0  # 4.x's default
 FLOWN_MODES = (FlightMode.STABILIZE, FlightMode.ALT_HOLD)
 # 4.x FS_THR_ENABLE values whose action FS_GCS_ENABLE numbers differently
 RADIO_AS_GCS_ACTION = {3.0: 5.0, 4.0: 3.0, 5.0: 4.0}
@@ -112,6 +114,7 @@ class Prediction:
     what: str  # what the vehicle would do, after "on a silent link the vehicle "
     fix: Mapping[str, float] = field(default_factory=dict)  # everything --fix-failsafe sets
     fix_words: str = ""  # how to fix `param`, for the refusal line
+    fixable: bool = False  # whether `fix` makes it safe
 
     @property
     def safe(self) -> bool:
@@ -124,7 +127,7 @@ class Prediction:
         text = f"{self.param} {value}: on a silent link the vehicle {self.what}"
         if self.safe:
             return text
-        how = f"{self.fix_words} or pass --fix-failsafe" if self.fix else self.fix_words
+        how = f"{self.fix_words} or pass --fix-failsafe" if self.fixable else self.fix_words
         return f"{text}; {how}" if how else text
 
 
@@ -145,9 +148,11 @@ def predict(dialect: Dialect, params: Mapping[str, float], state: VehicleState,
         return Prediction(Outcome.UNKNOWN, "mode", float(mode), f"in {mode.name} cannot be "
                           "predicted (the station flies STABILIZE or ALT_HOLD)")
     fix = safe_settings(dialect, params, state)
-    if dialect is Dialect.COPTER4:
-        return _copter4(params, state, fix)
-    return _apm25(params, state, fix)
+    judge = _copter4 if dialect is Dialect.COPTER4 else _apm25
+    p = judge(params, state, fix)
+    if p.safe or not fix:
+        return p
+    return dataclasses.replace(p, fixable=judge({**params, **fix}, state, {}).safe)
 
 
 def safe_settings(dialect: Dialect, params: Mapping[str, float],
@@ -164,10 +169,11 @@ def safe_settings(dialect: Dialect, params: Mapping[str, float],
         if action == 0 or not _copter4_action(action, state, params)[0].safe:
             out["FS_GCS_ENABLE"] = LAND_ACTION
         lapse, timeout = g("RC_OVERRIDE_TIME", 0.0), g("FS_GCS_TIMEOUT", 0.0)
+        if 0 <= lapse <= FS_GCS_TIMEOUT_MIN_S:  # ignored, or too short for any GCS timeout
+            lapse = out["RC_OVERRIDE_TIME"] = RC_OVERRIDE_TIME_DEFAULT_S
         if lapse > 0 and timeout >= lapse:
-            want = max(FS_GCS_TIMEOUT_MIN_S, float(int(lapse)) - 1.0)
-            if want < lapse:
-                out["FS_GCS_TIMEOUT"] = want
+            # the shortest timeout: the last override is flown blind until the failsafe acts
+            out["FS_GCS_TIMEOUT"] = FS_GCS_TIMEOUT_MIN_S
         return out
     if g("FS_GCS_ENABLE", 0.0) == 0:
         out["FS_GCS_ENABLE"] = 1.0
@@ -183,7 +189,7 @@ def _copter4(p: Mapping[str, float], state: VehicleState, fix: dict[str, float])
     lapse, timeout = p["RC_OVERRIDE_TIME"], p["FS_GCS_TIMEOUT"]
     if lapse == 0:
         return Prediction(Outcome.UNKNOWN, "RC_OVERRIDE_TIME", lapse, "ignores the station's "
-                          "sticks (0: overrides disabled)", fix_words="set RC_OVERRIDE_TIME 3")
+                          "sticks (0: overrides disabled)", fix, "set RC_OVERRIDE_TIME 3")
     if action == 0:
         outcome, what = _copter4_no_gcs_failsafe(p, state, "no GCS failsafe")
         return Prediction(outcome, "FS_GCS_ENABLE", action, what, fix,
@@ -197,7 +203,10 @@ def _copter4(p: Mapping[str, float], state: VehicleState, fix: dict[str, float])
                           f"keeps flying on the receiver's throttle from {lapse:g} s, when the "
                           f"overrides lapse (RC_OVERRIDE_TIME {lapse:g}), before its failsafe at "
                           f"{timeout:g} s", fix,
-                          f"set FS_GCS_TIMEOUT under RC_OVERRIDE_TIME {lapse:g}")
+                          f"set FS_GCS_TIMEOUT under RC_OVERRIDE_TIME {lapse:g}"
+                          if lapse > FS_GCS_TIMEOUT_MIN_S else
+                          f"set RC_OVERRIDE_TIME over FS_GCS_TIMEOUT's least "
+                          f"{FS_GCS_TIMEOUT_MIN_S:g} s")
     outcome, what = _copter4_action(action, state, p)
     return Prediction(outcome, "FS_GCS_ENABLE", action, f"after {timeout:g} s {what}", fix,
                       f"set FS_GCS_ENABLE {LAND_ACTION:g}")

@@ -133,8 +133,8 @@ def test_prediction_table(dialect: Dialect, params: dict[str, float], state: Veh
     assert "\n" not in line
     assert line.startswith(f"{param} {params[param]:g}: on a silent link the vehicle ")
     assert p.safe == outcome.safe
-    if not p.safe and p.fix:
-        assert line.endswith("or pass --fix-failsafe")
+    if not p.safe:
+        assert line.endswith("or pass --fix-failsafe") == p.fixable
 
 
 def test_the_refusal_line_for_4x_default_fs_options() -> None:
@@ -157,7 +157,11 @@ def test_the_refusal_line_for_3_2_1_defaults_with_gps() -> None:
     (C4, _p(C4_DEFAULTS, FS_OPTIONS=23.0, RC_OVERRIDE_TIME=10.0), NO_GPS,
      {"FS_OPTIONS": 7.0, "FS_GCS_ENABLE": 5.0}),
     (C4, _p(C4_DEFAULTS, RC_OVERRIDE_TIME=6.5, FS_GCS_TIMEOUT=8.0), NO_GPS,
-     {"FS_OPTIONS": 0.0, "FS_GCS_ENABLE": 5.0, "FS_GCS_TIMEOUT": 5.0}),
+     {"FS_OPTIONS": 0.0, "FS_GCS_ENABLE": 5.0, "FS_GCS_TIMEOUT": 2.0}),
+    (C4, _p(C4_SAFE, RC_OVERRIDE_TIME=1.5), NO_GPS,
+     {"RC_OVERRIDE_TIME": 3.0}),
+    (C4, _p(C4_SAFE, RC_OVERRIDE_TIME=0.0, FS_GCS_TIMEOUT=5.0), NO_GPS,
+     {"RC_OVERRIDE_TIME": 3.0, "FS_GCS_TIMEOUT": 2.0}),
     (C4, _p(C4_SAFE, FS_GCS_ENABLE=1.0), NO_GPS, {}),  # RTL without a position lands
     (C4, _p(C4_SAFE, FS_GCS_ENABLE=1.0), GPS, {"FS_GCS_ENABLE": 5.0}),
     (C4, C4_SAFE, GPS, {}),
@@ -171,9 +175,9 @@ def test_fix_failsafe_sets(dialect: Dialect, params: dict[str, float], state: Ve
     assert safe_settings(dialect, params, state) == want
 
 
-GRID = {
+GRID: dict[Dialect, dict[str, tuple[float, ...]]] = {
     C4: {"FS_GCS_ENABLE": (0, 1, 2, 3, 4, 5, 6, 7, 9), "FS_GCS_TIMEOUT": (2, 3, 5),
-         "FS_OPTIONS": (0, 2, 16, 18), "RC_OVERRIDE_TIME": (-1, 3, 10),
+         "FS_OPTIONS": (0, 2, 16, 18), "RC_OVERRIDE_TIME": (-1, 0, 1.5, 3, 10),
          "FS_THR_ENABLE": (0, 1, 3, 7), "RC_FS_TIMEOUT": (1,), "RTL_ALT": (0, 1500)},
     APM: {"FS_GCS_ENABLE": (0, 1, 2, 3), "FS_THR_ENABLE": (0, 1, 2, 3),
           "RTL_ALT": (0, 1500), "RTL_ALT_FINAL": (0, 200)},
@@ -203,6 +207,8 @@ def test_every_combination_is_judged_and_the_fix_makes_it_safe(dialect: Dialect)
             fixed = {**params, **safe_settings(dialect, params, state)}
             after = predict(dialect, fixed, state)
             assert after.safe, (params, state, after.line())
+            assert p.safe or p.fixable, line
+            assert p.safe or line.endswith("or pass --fix-failsafe"), line
             judged += 1
     assert judged == len(STATES) * len(list(itertools.product(*grid.values())))
 
@@ -235,3 +241,10 @@ def test_the_real_firmwares_parameters(name: str, dialect: Dialect, outcome: Out
     assert (p.outcome, p.param) == (outcome, param), p.line()
     fixed = {**params, **safe_settings(dialect, params, GPS)}
     assert predict(dialect, fixed, GPS).safe
+
+
+def test_an_override_lapse_too_short_for_any_gcs_timeout() -> None:
+    p = predict(C4, _p(C4_SAFE, RC_OVERRIDE_TIME=1.5), NO_GPS)
+    assert (p.outcome, p.param) == (Outcome.KEEPS_FLYING, "FS_GCS_TIMEOUT")
+    assert p.line().endswith("set RC_OVERRIDE_TIME over FS_GCS_TIMEOUT's least 2 s or pass "
+                             "--fix-failsafe")
