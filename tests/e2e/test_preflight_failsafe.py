@@ -84,6 +84,8 @@ def _fly_tcp(sitl: SitlProcess, *argv: str) -> subprocess.CompletedProcess[str]:
                    "--speedup", f"{SPEEDUP:g}", *argv)
 
 
+# a wall-clock flight (4x): beside other wall-clock flights only (make test's `wallclock` pass)
+@pytest.mark.wallclock
 def test_tcp_copter4_fs_options_16_is_refused_then_fixed(copter4_tcp: SitlProcess) -> None:
     # as the fixture flights had 4.7: the GCS failsafe on and early, FS_OPTIONS its default
     _set(copter4_tcp, FS_GCS_ENABLE=5.0, FS_GCS_TIMEOUT=2.0)
@@ -106,6 +108,7 @@ def test_tcp_copter4_fs_options_16_is_refused_then_fixed(copter4_tcp: SitlProces
         link.close()
 
 
+@pytest.mark.wallclock
 def test_tcp_copter4_rtl_is_judged_by_the_gps_fix_it_reports(copter4_tcp: SitlProcess) -> None:
     # FS_GCS_ENABLE 1 (RTL) climbs to RTL_ALT with a GPS fix and lands without one: the SITL
     # reports no fix, so the station flies only if it asked for GPS_RAW_INT and heard it
