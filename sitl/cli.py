@@ -137,10 +137,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "(the radio failsafe acts when the overrides stop)",
     )
     parser.add_argument(
-        "--no-gps",
-        action="store_true",
-        help="no GPS fix: RTL is refused and every RTL-like failsafe lands (default: a fix "
-        "with home set, as the real simulators have)",
+        "--gps",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="a GPS fix with home set, as the real simulators have: RTL flies and 3.2.1's "
+        "GCS failsafe climbs to RTL_ALT (default: no fix, as indoors; RTL-like failsafes land)",
     )
     parser.add_argument(
         "--home-distance",
@@ -238,7 +239,7 @@ def _server_from_args(args: argparse.Namespace) -> SitlServer:
             realistic_boot=opts.realistic_boot or args.realistic_boot,
             copter4_version=args.copter4_version or opts.copter4_version,
             rc_input=RcInput(args.rc_input) if args.rc_input else opts.rc_input,
-            gps=opts.gps and not args.no_gps,
+            gps=opts.gps if args.gps is None else args.gps,
             home_distance_m=(
                 opts.home_distance_m if args.home_distance is None else args.home_distance
             ),

@@ -72,18 +72,20 @@ class AutopilotOptions:
     `params`: parameter values the vehicle boots with, as a real SITL's defaults file sets
     them (a battery failsafe the owner turned on, say); names are the profile's own.
     `rc_input`: the RC receiver (absent, or present with the throttle at minimum or mid).
-    `gps`: a GPS fix with home set (RTL possible); without it RTL-like failsafes land.
+    `gps`: a GPS fix with home set (RTL possible); without it RTL-like failsafes land. Off by
+    default: the vehicles this SITL stands for fly indoors, where a GPS has no lock (the real
+    simulators have one: `--gps`, `[autopilot] gps = true`).
     `home_distance_m`: how far from home the vehicle's GPS position puts it while it flies over
     its take-off point; both firmwares pick RTL over LAND when it exceeds WPNAV_RADIUS (2 m).
-    The defaults are the real simulators' (receiver at 1000 µs, GPS with home), and the real
-    3.2.1 SITL chose RTL in every measured fade (fixtures/README.md), so home reads > 2 m away.
+    The receiver's default is the real simulators' (at 1000 µs), and the real 3.2.1 SITL chose
+    RTL in every measured fade (fixtures/README.md), so home reads > 2 m away with a fix.
     """
 
     realistic_boot: bool = False
     copter4_version: str = "4.7"
     params: tuple[tuple[str, float], ...] = ()
     rc_input: RcInput = RcInput.MIN
-    gps: bool = True
+    gps: bool = False
     home_distance_m: float = 3.0
 
     def __post_init__(self) -> None:

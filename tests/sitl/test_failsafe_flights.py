@@ -72,7 +72,7 @@ def test_copter4_receiver_at_mid_keeps_stabilize_flying_after_the_lapse() -> Non
 
 def test_apm25_rtl_alt_0_returns_at_the_current_height_then_lands() -> None:
     """3.2.1, receiver at minimum, GPS: the GCS failsafe's RTL with RTL_ALT 0 does not climb."""
-    gcs = _make(Profile.APM25, AutopilotOptions(), RTL_ALT=0.0, RTL_LOIT_TIME=1000.0)
+    gcs = _make(Profile.APM25, AutopilotOptions(gps=True), RTL_ALT=0.0, RTL_LOIT_TIME=1000.0)
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.0)
     gcs.set_mode(1, int(FlightMode.ALT_HOLD))
@@ -96,7 +96,7 @@ def test_apm25_rtl_alt_0_returns_at_the_current_height_then_lands() -> None:
 def test_apm25_land_waits_for_minimum_throttle_and_a_silent_station_gets_rtl() -> None:
     """3.2.1 LAND touches down but stays armed while the override holds the throttle up; the
     station going quiet then meets the GCS failsafe: RTL re-launches the landed vehicle."""
-    gcs = _make(Profile.APM25, AutopilotOptions())
+    gcs = _make(Profile.APM25, AutopilotOptions(gps=True))
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.0)
     gcs.set_mode(1, int(FlightMode.LAND))
