@@ -20,7 +20,7 @@ from sitl.autopilot.alt_hold import (
 )
 from sitl.autopilot.arming import CommandResult, MavResult, Severity
 from sitl.autopilot.attitude import AttitudeController
-from sitl.autopilot.failsafe import BatteryWatch, GcsWatch, RadioWatch
+from sitl.autopilot.failsafe import BatteryWatch, GcsWatch, RadioWatch, ThrottleLowWatch
 from sitl.autopilot.failsafe_run import run_failsafes
 from sitl.autopilot.gains import Gains
 from sitl.autopilot.inertial_nav import InertialNavZ
@@ -79,6 +79,8 @@ class Autopilot:
         self.land = LandDetector(climb_max_ms=0.4 if profile is Profile.APM25 else 1.0)
         self.gcs = GcsWatch()
         self.radio_watch = RadioWatch()
+        self.throttle_low = ThrottleLowWatch()
+        self.throttle_up_s = 0.0  # when the throttle stick was last above zero
         self.battery = BatteryWatch()
         self.spool = Spool()
         self.state = AutopilotState()

@@ -8,9 +8,10 @@ in `failsafe_rules.py`.
   default is 0: no GCS failsafe).
 - Radio failsafe (FS_THR_ENABLE) with no RC receiver: the only radio input is the GCS's
   overrides, so `read_radio()` sees no new frame RC_FS_TIMEOUT (4.x, 1 s) or
-  FAILSAFE_RADIO_TIMEOUT_MS (3.2.1, 2 s) after the last override. With a receiver whose
-  throttle stays above FS_THR_VALUE (975 µs) it never fires. A vehicle without overrides ever
-  has no input to lose.
+  FAILSAFE_RADIO_TIMEOUT_MS (3.2.1, 2 s) after the last override. With a receiver it fires
+  when the throttle channel reads under FS_THR_VALUE (975 µs): a receiver at 1000 or 1500 µs
+  never does, unless FS_THR_VALUE is raised over it. A vehicle without overrides ever has no
+  input to lose.
 """
 
 from __future__ import annotations
@@ -78,6 +79,35 @@ class RadioWatch:
             self.active = True
             return True
         if not late and self.active:
+            self.active = False
+            return False
+        return None
+
+
+FS_COUNTER = 3  # both firmwares: three low throttle reads in a row start the radio failsafe
+
+
+@dataclass
+class ThrottleLowWatch:
+    """The radio failsafe with a receiver: its throttle under FS_THR_VALUE
+    (`set_throttle_and_failsafe` in both firmwares: three low reads while armed start it, as
+    many good ones end it)."""
+
+    count: int = 0
+    active: bool = False
+
+    def check(self, low: bool, armed: bool) -> bool | None:
+        """True on the read the failsafe starts, False when it ends, else None."""
+        if low:
+            if self.active or not armed:
+                return None
+            self.count += 1
+            if self.count >= FS_COUNTER:
+                self.active = True
+                return True
+            return None
+        self.count = max(0, self.count - 1)
+        if self.active and self.count == 0:
             self.active = False
             return False
         return None

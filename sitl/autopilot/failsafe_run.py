@@ -21,6 +21,8 @@ from sitl.autopilot.profile import FlightMode, Profile, RcInput
 if TYPE_CHECKING:
     from sitl.autopilot.autopilot import Autopilot
 
+THROTTLE_ZERO_DEBOUNCE_S = 0.4  # 4.x THROTTLE_ZERO_DEBOUNCE_TIME_MS
+
 
 def situation(ap: Autopilot, throttle_zero: bool) -> Situation:
     """What the failsafe code sees of the vehicle now."""
@@ -56,11 +58,15 @@ def _radio(ap: Autopilot, t_s: float, throttle_zero: bool) -> None:
     st = ap.state
     apm = ap.profile is Profile.APM25
     enabled = int(ap.params.k(Key.FS_THR_ENABLE))
-    if enabled == 0 or ap.options.rc_input is not RcInput.ABSENT:
+    if enabled == 0:
         if st.radio_failsafe:
-            st.radio_failsafe = ap.radio_watch.active = False
+            st.radio_failsafe = ap.radio_watch.active = ap.throttle_low.active = False
         return
-    change = ap.radio_watch.check(t_s, st.armed, ap.params.k(Key.RADIO_TIMEOUT_S))
+    if ap.options.rc_input is RcInput.ABSENT:
+        change = ap.radio_watch.check(t_s, st.armed, ap.params.k(Key.RADIO_TIMEOUT_S))
+    else:
+        low = ap.radio.channel(2) < ap.params.k(Key.FS_THR_VALUE)
+        change = ap.throttle_low.check(low, st.armed)
     if change is True:
         st.radio_failsafe = True
         s = situation(ap, throttle_zero)
@@ -100,8 +106,13 @@ def _gcs(ap: Autopilot, t_s: float, throttle_zero: bool, timeout_s: float) -> No
 
 def run_failsafes(ap: Autopilot, t_s: float, battery_v: float, gcs_timeout_s: float) -> None:
     """Radio, GCS and battery failsafes for one tick."""
-    # the throttle as the failsafe code sees it, before the overrides are cleared
-    throttle_zero = ap.throttle_stick() <= 0.0
+    # the throttle as the failsafe code sees it, before the overrides are cleared: 3.2.1 reads
+    # control_in == 0 at once, 4.x's ap.throttle_zero only after 0.4 s at zero
+    stick_zero = ap.throttle_stick() <= 0.0
+    if not stick_zero:
+        ap.throttle_up_s = t_s
+    apm = ap.profile is Profile.APM25
+    throttle_zero = stick_zero and (apm or t_s - ap.throttle_up_s > THROTTLE_ZERO_DEBOUNCE_S)
     _radio(ap, t_s, throttle_zero)
     _gcs(ap, t_s, throttle_zero, gcs_timeout_s)
     st = ap.state

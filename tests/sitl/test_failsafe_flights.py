@@ -131,3 +131,20 @@ def test_apm25_land_disarms_once_the_throttle_is_at_minimum() -> None:
     pilot.sticks[2] = 1000
     pilot.fly(0.2)
     assert not ap.state.armed
+
+
+def test_copter4_receiver_under_fs_thr_value_starts_the_radio_failsafe_at_the_lapse() -> None:
+    """A receiver at 1000 µs with FS_THR_VALUE raised to 1010 in the air (on the ground the
+    1000 µs arming throttle would trip it at once): once the overrides lapse (RC_OVERRIDE_TIME
+    3 s) the throttle reads under it and the radio failsafe acts (RTL)."""
+    gcs = _make(Profile.COPTER4, AutopilotOptions())
+    pilot = Pilot(gcs)
+    take_off(gcs, pilot, 1.0)
+    gcs.send(mavlink.MAVLink_param_set_message(1, 1, b"FS_THR_VALUE", 1010.0, 9))
+    pilot.fly(1.0)
+    pilot.overrides = False
+    msgs = pilot.fly(2.8)
+    assert _mode(gcs) == FlightMode.STABILIZE
+    msgs = pilot.fly(0.4)
+    assert "Radio Failsafe" in _texts(msgs)
+    assert _mode(gcs) == FlightMode.RTL
