@@ -3,11 +3,11 @@
 These carry what the simulated vehicle knows (its own estimate, battery, motor outputs) and the
 firmware's fixed values otherwise, so that REQUEST_DATA_STREAM(ALL) puts the real firmware's
 messages and bytes on the link (see `sitl.link.streams`). GPS_RAW_INT tells the fix the
-autopilot flies with (its `gps` option): a 3D fix at the world's origin when it has one, fix
-type 1 (no fix) at 0° / 0° as an APM without a lock sends it otherwise; a station judging what
-RTL would do reads the same GPS the failsafe acts on. There is no compass. Fields the station has no use for and
-the SITL does not model (terrain, mission, memory) hold the constants the firmware reports on
-the ground.
+autopilot flies with (its `gps` option): a 3D fix at the world's origin when it has one,
+fix type 1 (no fix) at 0° / 0° as an APM without a lock sends it otherwise; a station
+judging what RTL would do reads the same GPS the failsafe acts on. There is no compass.
+Fields the station has no use for and the SITL does not model (terrain, mission, memory)
+hold the constants the firmware reports on the ground.
 """
 
 from __future__ import annotations

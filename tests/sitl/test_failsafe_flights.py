@@ -134,9 +134,9 @@ def test_apm25_land_disarms_once_the_throttle_is_at_minimum() -> None:
 
 
 def test_copter4_receiver_under_fs_thr_value_starts_the_radio_failsafe_at_the_lapse() -> None:
-    """A receiver at 1000 µs with FS_THR_VALUE raised to 1010 in the air (GPS: RTL; on the ground the
+    """A receiver at 1000 µs with FS_THR_VALUE raised to 1010 in the air (on the ground the
     1000 µs arming throttle would trip it at once): once the overrides lapse (RC_OVERRIDE_TIME
-    3 s) the throttle reads under it and the radio failsafe acts (RTL)."""
+    3 s) the throttle reads under it and the radio failsafe acts (RTL, with a GPS fix)."""
     gcs = _make(Profile.COPTER4, AutopilotOptions(gps=True))
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.0)
