@@ -19,6 +19,7 @@ import numpy as np
 
 from sitl.autopilot import Autopilot, AutopilotOptions, ParamStore, Profile, SensorSample
 from sitl.autopilot.params import Key
+from sitl.autopilot.rangefinder import firmware_reading
 from sitl.link.channel import Channel
 from sitl.link.handler import VehicleLink
 from sitl.link.view import GeoOrigin, VehicleView
@@ -63,8 +64,8 @@ class VehicleRuntime:
         self.params.set_key(Key.SYSID_THISMAV, sysid)
         o = world.origin
         sonar = world.sensors.sonar
-        # the owner configured the rangefinder for the fitted HC-SR04
-        self.params.set_key(Key.RNG_MIN_M, sonar.min_m)
+        # the owner set the rangefinder's maximum for the fitted HC-SR04; its minimum stays the
+        # firmware's (RNGFND1_MIN 0.2 m, RNGFND_MIN_CM 20): below it the firmware flies blind
         self.params.set_key(Key.RNG_MAX_M, sonar.max_m)
         self.autopilot = Autopilot(profile, self.params, self.vehicle.hover_throttle(), options)
         for name, value in options.params:  # the owner's values win over the set-up above
@@ -113,8 +114,11 @@ class VehicleRuntime:
         sonar = v.sonar()
         sonar_m = None
         if sonar is not None:
-            sonar_m = sonar.distance_m if sonar.valid else None
-            c.sonar_m = sonar_m
+            c.sonar_m = sonar.distance_m if sonar.valid else None
+            reading = firmware_reading(self.params, c.sonar_m)
+            c.rangefinder = reading
+            # the autopilot uses only what its driver calls in range (not below RNGFND min)
+            sonar_m = reading.distance_cm / 100.0 if reading.valid else None
         batt = v.battery
         c.battery_v, c.current_a = batt.voltage_v, batt.current_a
         c.remaining_pct = batt.remaining_pct

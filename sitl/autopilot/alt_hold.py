@@ -9,16 +9,86 @@ throttle_average, 4.x's MOT_HOVER_LEARN), which is what keeps the integrator sma
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from sitl.autopilot.gains import Gains
 from sitl.autopilot.pid import Pid, PidTerms
 from sitl.tick_record import tick_record
 
 ACCEL_Z_MAX_CMSS = 250.0  # target acceleration bound (PILOT_ACCEL_Z)
-ACCEL_FILT_HZ = 20.0
 HOVER_LEARN_TC_S = 2.0
 LEASH_CM = 300.0  # max altitude error kept in the target, as the firmware's leash
 TAKEOFF_JUMP_CM = 20.0  # AC_PosControl's takeoff target jump
+
+
+@dataclass(frozen=True)
+class CascadeShape:
+    """Where the two firmwares' cascades differ (AC_PosControl 3.2 vs 4.x), fitted to the
+    `althold-steps` fixtures.
+
+    3.2.1 has no velocity feed-forward: the climb rate target is only POS_Z_P × the position
+    error, so a stick step reaches its rate with a ≈ 1 s lag (fixture: 0.80 of the rate 2 s into
+    a 1900 µs step, 0.91 at 4 s); it low-passes the velocity error at 4 Hz
+    (POSCONTROL_VEL_ERROR_CUTOFF_FREQ) and the acceleration error at 2 Hz
+    (POSCONTROL_THROTTLE_CUTOFF_FREQ). 4.x feeds the pilot's rate forward (its rate within 1 s,
+    fixture) and filters the errors at PSC_VELZ_FLTE 5 Hz and PSC_ACCZ_FLTE 20 Hz.
+    Both read the accelerometer through a 20 Hz low-pass (3.2.1: the MPU-6000's DLPF;
+    4.x: INS_ACCEL_FILTER).
+    """
+
+    velocity_feed_forward: bool
+    vel_err_hz: float
+    acc_err_hz: float
+    accel_in_hz: float = 20.0
+    jerk_cmsss: float = 0.0  # 4.x shapes the pilot's rate (PSC_JERK_Z 5 m/s³); 0 = not at all
+
+
+SHAPE_APM25 = CascadeShape(velocity_feed_forward=False, vel_err_hz=4.0, acc_err_hz=2.0)
+SHAPE_COPTER4 = CascadeShape(
+    velocity_feed_forward=True, vel_err_hz=5.0, acc_err_hz=20.0, jerk_cmsss=500.0
+)
+
+
+def _alpha(dt_s: float, hz: float) -> float:
+    return dt_s / (dt_s + 1.0 / (2.0 * math.pi * hz))
+
+
+def _sqrt_shape(error: float, p: float, limit: float) -> float:
+    """AP's sqrt_controller: p × error near zero, the √ of a constant deceleration beyond."""
+    linear = limit / (p * p)
+    if error > linear:
+        return math.sqrt(2.0 * limit * (error - linear / 2.0))
+    if error < -linear:
+        return -math.sqrt(2.0 * limit * (-error - linear / 2.0))
+    return p * error
+
+
+class RateShaper:
+    """4.x's input shaping of the pilot's climb rate (shape_vel_accel): the desired velocity
+    moves toward the stick's rate with acceleration at most PILOT_ACCEL_Z and its change at most
+    PSC_JERK_Z. So a climb starts and stops smoothly and a centred stick brakes over
+    ≈ v² / 2a plus the jerk ramp: 1.5 m from 1.88 m/s (fixture: +1.5 m after 1900 µs)."""
+
+    def __init__(self, accel_max_cmss: float, jerk_cmsss: float) -> None:
+        self.accel_max = accel_max_cmss
+        self.jerk = jerk_cmsss
+        self.vel_cms = 0.0
+        self.accel_cmss = 0.0
+
+    def reset(self, vel_cms: float = 0.0) -> None:
+        """Start from `vel_cms` with no acceleration."""
+        self.vel_cms = vel_cms
+        self.accel_cmss = 0.0
+
+    def update(self, rate_cms: float, dt_s: float) -> float:
+        """Advance by `dt_s` toward `rate_cms`; returns the distance moved (cm)."""
+        a_cmd = _sqrt_shape(rate_cms - self.vel_cms, self.jerk / self.accel_max, self.jerk)
+        a_cmd = min(self.accel_max, max(-self.accel_max, a_cmd))
+        step = self.jerk * dt_s
+        self.accel_cmss += min(step, max(-step, a_cmd - self.accel_cmss))
+        moved = self.vel_cms * dt_s + 0.5 * self.accel_cmss * dt_s * dt_s
+        self.vel_cms += self.accel_cmss * dt_s
+        return moved
 
 
 @tick_record
@@ -35,12 +105,18 @@ class AltHoldOutput:
 class AltitudeController:
     """Position → velocity → acceleration cascade driving the collective throttle."""
 
-    def __init__(self, gains: Gains, hover_throttle: float) -> None:
+    def __init__(
+        self, gains: Gains, hover_throttle: float, shape: CascadeShape = SHAPE_COPTER4
+    ) -> None:
         self.gains = gains
         self.hover_throttle = hover_throttle
+        self.shape = shape
         self.target_alt_cm = 0.0
         self._pid = Pid(gains.acc_z)
         self._acc_filtered = 0.0
+        self._vel_err = 0.0
+        self._accel_in: float | None = None
+        self._shaper = RateShaper(ACCEL_Z_MAX_CMSS, shape.jerk_cmsss or 1.0)
         self._limit_low = False
         self._limit_high = False
 
@@ -58,6 +134,8 @@ class AltitudeController:
         self._pid.reset()
         self._pid._integrator = (throttle_now - self.hover_throttle) * 1000.0
         self._acc_filtered = 0.0
+        self._vel_err = 0.0
+        self._shaper.reset()
 
     def init_takeoff(self, alt_cm: float) -> None:
         """Leaving the ground in ALT_HOLD: aim a little above and drop a negative I term,
@@ -97,19 +175,34 @@ class AltitudeController:
         """Move the target at `climb_rate_cms` and return the throttle to follow it."""
         g = self.gains
         # don't let the target run away while the motors are saturated
-        if not (
-            (self._limit_high and climb_rate_cms > 0) or (self._limit_low and climb_rate_cms < 0)
-        ):
-            self.target_alt_cm += climb_rate_cms * dt_s
+        shape = self.shape
+        blocked = (self._limit_high and climb_rate_cms > 0) or (
+            self._limit_low and climb_rate_cms < 0
+        )
+        if shape.jerk_cmsss > 0.0:
+            moved = self._shaper.update(0.0 if blocked else climb_rate_cms, dt_s)
+            self.target_alt_cm += moved
+            feed_forward = self._shaper.vel_cms
+        else:
+            if not blocked:
+                self.target_alt_cm += climb_rate_cms * dt_s
+            feed_forward = climb_rate_cms
         self.target_alt_cm = min(alt_cm + LEASH_CM, max(alt_cm - LEASH_CM, self.target_alt_cm))
-        vel_target = self._sqrt_controller(self.target_alt_cm - alt_cm) + climb_rate_cms
+        vel_target = self._sqrt_controller(self.target_alt_cm - alt_cm)
+        if shape.velocity_feed_forward:
+            vel_target += feed_forward
         vmax = g.pilot_velz_max_cms
         vel_target = min(vmax, max(-vmax, vel_target))
-        acc_target = g.vel_z_p * (vel_target - vel_cms)
+        self._vel_err += _alpha(dt_s, shape.vel_err_hz) * (vel_target - vel_cms - self._vel_err)
+        acc_target = g.vel_z_p * self._vel_err
+        if shape.jerk_cmsss > 0.0:
+            acc_target += self._shaper.accel_cmss  # 4.x feeds the shaped acceleration forward
         acc_target = min(ACCEL_Z_MAX_CMSS, max(-ACCEL_Z_MAX_CMSS, acc_target))
-        alpha = dt_s / (dt_s + 1.0 / (2.0 * math.pi * ACCEL_FILT_HZ))
-        err = acc_target - accel_cmss
-        self._acc_filtered += alpha * (err - self._acc_filtered)
+        if self._accel_in is None:
+            self._accel_in = accel_cmss
+        self._accel_in += _alpha(dt_s, shape.accel_in_hz) * (accel_cmss - self._accel_in)
+        err = acc_target - self._accel_in
+        self._acc_filtered += _alpha(dt_s, shape.acc_err_hz) * (err - self._acc_filtered)
         terms = self._pid.update(
             self._acc_filtered, dt_s, limit_i=self._limit_high or self._limit_low
         )
@@ -149,6 +242,7 @@ class SurfaceTracker:
         self.health = 0
         self.sonar_alt_cm: float | None = None
         self.target_cm: float | None = None
+        self._terrain_cm: float | None = None
 
     def reading(self, distance_m: float | None, tilt_cos: float, gains: Gains) -> None:
         """Feed a new sonar reading (None = no echo / out of range)."""
@@ -195,3 +289,22 @@ class SurfaceTracker:
         error = (self.target_cm - self.sonar_alt_cm) - (alt_target_cm - alt_cm)
         correction = min(self.VELZ_MAX_CMS, max(-self.VELZ_MAX_CMS, error * gain))
         return target_rate_cms + correction
+
+    def terrain_shift(self, alt_cm: float, dt_s: float, tc_s: float) -> float:
+        """4.x's surface tracking (SURFTRAK_MODE 1): the floor's height in the estimator's frame,
+        alt − rangefinder, low-passed with SURFTRAK_TC, moves the position target by as much as
+        it changes. Acquiring the floor again starts from the current offset, so nothing jumps
+        (3.2.1's tracker, above, re-targets the surface distance instead). Returns the shift, cm.
+        """
+        if not self.healthy:
+            self._terrain_cm = None
+            return 0.0
+        assert self.sonar_alt_cm is not None
+        measured = alt_cm - self.sonar_alt_cm
+        if self._terrain_cm is None:
+            self._terrain_cm = measured
+            return 0.0
+        before = self._terrain_cm
+        self._terrain_cm += dt_s / (max(tc_s, dt_s) + dt_s) * (measured - before)
+        return self._terrain_cm - before
+

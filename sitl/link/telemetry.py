@@ -17,6 +17,7 @@ import math
 from typing import Any
 
 from sitl.autopilot import FlightMode, Key, Profile
+from sitl.autopilot.rangefinder import distance_sensor_cm
 from sitl.link.codec import messages
 from sitl.link.view import VehicleView
 
@@ -27,6 +28,8 @@ MAV_AUTOPILOT_ARDUPILOTMEGA = 3
 BASE_MODE_DISARMED = 81  # CUSTOM_MODE_ENABLED | STABILIZE_ENABLED | MANUAL_INPUT_ENABLED
 BASE_MODE_ARMED = 209  # + SAFETY_ARMED
 BASE_MODE_BOOT = 89  # what ArduCopter reports while it initialises (measured on 4.7)
+MAV_MODE_FLAG_GUIDED_ENABLED = 8  # RTL and SmartRTL in both firmwares (3.2.1 RTL armed: 217)
+GUIDED_MODES = frozenset({FlightMode.RTL, FlightMode.SMART_RTL})
 MAV_DISTANCE_SENSOR_ULTRASOUND = 1
 MAV_SENSOR_ROTATION_PITCH_270 = 25  # facing down
 
@@ -63,6 +66,8 @@ def heartbeat(v: VehicleView) -> Any:
         base_mode = BASE_MODE_BOOT
     else:
         base_mode = BASE_MODE_DISARMED
+    if st.mode in GUIDED_MODES:
+        base_mode |= MAV_MODE_FLAG_GUIDED_ENABLED
     return messages.MAVLink_heartbeat_message(
         MAV_TYPE_QUADROTOR,
         MAV_AUTOPILOT_ARDUPILOTMEGA,
@@ -161,21 +166,17 @@ def servo_output_raw(v: VehicleView) -> Any:
 
 
 def rangefinder_cm(v: VehicleView) -> int:
-    """The down sonar as the autopilot reports it: whole centimetres (AP_RangeFinder keeps
-    distance_cm as an integer), 0 without an echo or outside RNGFND min..max (so 0 on the floor,
-    below the minimum, as both real firmwares read on the ground)."""
-    d = v.cache.sonar_m
-    if d is None:
-        return 0
-    cm = round(d * 100.0)
-    lo = round(v.params.k(Key.RNG_MIN_M) * 100.0)
-    hi = round(v.params.k(Key.RNG_MAX_M) * 100.0)
-    return cm if lo <= cm <= hi else 0
+    """The down rangefinder as the autopilot reports it: the driver's whole centimetres, below
+    RNGFND min too (both real firmwares send those while climbing through them; fixtures),
+    0 with no echo (so 0 on the floor, where the sensor is too close to hear one)."""
+    return v.cache.rangefinder.distance_cm
 
 
 def rangefinder(v: VehicleView) -> Any:
-    """RANGEFINDER: metres as a float32 of whole centimetres / 100 (3.2.1's distance_cm * 0.01)."""
-    return messages.MAVLink_rangefinder_message(rangefinder_cm(v) * 0.01, 0.0)
+    """RANGEFINDER: metres as a float32 of whole centimetres / 100 (3.2.1's distance_cm * 0.01),
+    and the analog sonar's voltage (3.2.1; 0 on 4.x)."""
+    r = v.cache.rangefinder
+    return messages.MAVLink_rangefinder_message(r.distance_cm * 0.01, r.voltage_v)
 
 
 def distance_sensor_down(v: VehicleView) -> Any:
@@ -185,7 +186,7 @@ def distance_sensor_down(v: VehicleView) -> Any:
         boot_ms(v),
         round(p.k(Key.RNG_MIN_M) * 100.0),
         round(p.k(Key.RNG_MAX_M) * 100.0),
-        rangefinder_cm(v),
+        distance_sensor_cm(rangefinder_cm(v)),
         MAV_DISTANCE_SENSOR_ULTRASOUND,
         0,
         MAV_SENSOR_ROTATION_PITCH_270,

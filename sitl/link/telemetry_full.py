@@ -2,11 +2,12 @@
 
 These carry what the simulated vehicle knows (its own estimate, battery, motor outputs) and the
 firmware's fixed values otherwise, so that REQUEST_DATA_STREAM(ALL) puts the real firmware's
-messages and bytes on the link (see `sitl.link.streams`). The vehicle has no GPS and no compass:
-GPS_RAW_INT reports fix type 1 (no fix), positions are 0° / 0° with the height of the
-autopilot's estimate, as an APM without GPS sends them. Fields the station has no use for and
-the SITL does not model (terrain, mission, memory) hold the constants the firmware reports on
-the ground.
+messages and bytes on the link (see `sitl.link.streams`). GPS_RAW_INT tells the fix the
+autopilot flies with (its `gps` option): a 3D fix at the world's origin when it has one,
+fix type 1 (no fix) at 0° / 0° as an APM without a lock sends it otherwise; a station
+judging what RTL would do reads the same GPS the failsafe acts on. There is no compass.
+Fields the station has no use for and the SITL does not model (terrain, mission, memory)
+hold the constants the firmware reports on the ground.
 """
 
 from __future__ import annotations
@@ -20,6 +21,9 @@ from sitl.link.telemetry import GRAVITY_MSS, boot_ms, clamp16, imu_units
 from sitl.link.view import VehicleView
 
 GPS_NO_FIX = 1
+GPS_FIX_3D = 3
+GPS_SATELLITES = 10  # what the real simulators report with a fix
+GPS_EPH_CM = 121  # HDOP 1.21, the real simulators' value
 EKF_FLAGS_ATTITUDE_VERT = 0x1 | 0x4 | 0x8 | 0x20  # attitude, vertical velocity/position
 ESC_RPM_AT_FULL = 12000.0
 
@@ -54,9 +58,16 @@ def global_position_int(v: VehicleView) -> Any:
 
 
 def gps_raw_int(v: VehicleView) -> Any:
-    """GPS_RAW_INT of an APM without a GPS lock."""
+    """GPS_RAW_INT: the fix the autopilot's failsafes act on (RTL needs one)."""
+    if not v.autopilot.options.gps:
+        return messages.MAVLink_gps_raw_int_message(
+            int(v.t_s * 1e6), GPS_NO_FIX, 0, 0, 0, 65535, 65535, 0, 65535, 0
+        )
+    st = v.autopilot.state
     return messages.MAVLink_gps_raw_int_message(
-        int(v.t_s * 1e6), GPS_NO_FIX, 0, 0, 0, 65535, 65535, 0, 65535, 0
+        int(v.t_s * 1e6), GPS_FIX_3D, round(v.origin.lat_deg * 1e7),
+        round(v.origin.lon_deg * 1e7), round((v.origin.alt_amsl_m + st.alt_m) * 1000.0),
+        GPS_EPH_CM, GPS_EPH_CM, 0, 65535, GPS_SATELLITES,
     )
 
 

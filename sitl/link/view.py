@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from sitl.autopilot import Autopilot, ParamStore, Profile
+from sitl.autopilot.rangefinder import NO_READING, RangeReading
 
 
 @dataclass
@@ -16,6 +17,7 @@ class SensorCache:
     pressure_pa: float = 101325.0
     temperature_c: float = 25.0
     sonar_m: float | None = None  # last reading, None = no echo
+    rangefinder: RangeReading = NO_READING  # that reading as the firmware's driver holds it
     battery_v: float = 12.6
     current_a: float = 0.0
     remaining_pct: float = 100.0

@@ -19,7 +19,15 @@ import pytest
 from gcs.position_legs import fly_legs
 
 
-@pytest.mark.parametrize("profile", ["apm25", "copter4"])
+@pytest.mark.parametrize(
+    "profile",
+    [
+        pytest.param("apm25", marks=pytest.mark.xfail(strict=True, reason=(
+            "#32: over 3.2.1's analog sonar (6 cm steps) the altitude loop strays 0.155 m "
+            "during the 10 cm leg (floor 0.1 m)"))),
+        "copter4",
+    ],
+)
 def test_legs_meet_the_mission_floors(profile: str) -> None:
     step, short, long_ = fly_legs(profile, (0.1, 0.5, 2.0), seed=3, observe_s=8.0)
     assert step.overshoot_pct < 20.0, step  # 2 cm past a 10 cm step

@@ -7,6 +7,8 @@ from __future__ import annotations
 import pytest
 
 from sitl.autopilot import AutopilotOptions, FlightMode, Profile
+from sitl.autopilot.profile import RcInput
+from sitl.autopilot.rangefinder import firmware_reading
 from sitl.link import telemetry as tm
 from sitl.simulation import Simulation
 from sitl.world import WorldError, load_world
@@ -37,23 +39,38 @@ def _texts(gcs: MemoryGcs, msgs: list) -> list[str]:
 
 
 # ---- 1. rangefinder ------------------------------------------------------------------------
+# (true range, cm sent) as the fixtures show: 4.7 whole centimetres; 3.2.1's analog sonar in
+# ≈ 5.9 cm ADC steps, truncated. Both send readings below RNGFND min (0.15 m here), 0 with no
+# echo; the driver marks those below the minimum out of range and the autopilot ignores them.
+RANGE_CASES = {
+    Profile.COPTER4: ((1.23456, 123, True), (0.5049, 50, True), (0.15, 15, False),
+                      (0.012, 1, False), (None, 0, False)),
+    Profile.APM25: ((1.23456, 117, True), (0.5049, 47, True), (0.15, 10, False),
+                    (0.012, 0, False), (None, 0, False)),
+}  # fmt: skip
+
+
 @pytest.mark.parametrize("profile", [Profile.APM25, Profile.COPTER4])
-def test_rangefinder_reports_whole_centimetres_and_zero_outside_its_range(
+def test_rangefinder_reports_what_the_driver_reads_below_its_minimum_too(
     profile: Profile,
 ) -> None:
     sim = Simulation(big_room(), profile, 1, seed=3)
     view = sim.vehicle(1).view
-    for d, cm in ((1.23456, 123), (0.5049, 50), (0.012, 0), (4.2, 0), (None, 0)):
-        view.cache.sonar_m = d
+    name = "RNGFND_MIN_CM" if profile is Profile.APM25 else "RNGFND1_MIN"
+    assert view.params.get(name) == pytest.approx(20.0 if profile is Profile.APM25 else 0.2)
+    for d, cm, valid in RANGE_CASES[profile]:
+        reading = firmware_reading(view.params, d)
+        assert (reading.distance_cm, reading.valid) == (cm, valid), d
+        view.cache.rangefinder = reading
         assert tm.rangefinder_cm(view) == cm
         rf = tm.rangefinder(view)
         assert rf.distance == pytest.approx(cm / 100.0)
         assert tm.distance_sensor_down(view).current_distance == cm
-    # the owner's RNGFND minimum applies too: below it the reading is 0
-    name = "RNGFND_MIN_CM" if profile is Profile.APM25 else "RNGFND1_MIN"
-    view.params.set(name, 20.0 if profile is Profile.APM25 else 0.2)
-    view.cache.sonar_m = 0.15
-    assert tm.rangefinder_cm(view) == 0
+        # 3.2.1's voltage field is the ADC's whole millivolts (fixture: 4 mV for 4 cm)
+        assert rf.voltage == pytest.approx(reading.voltage_v)
+    assert firmware_reading(view.params, 0.5049).voltage_v == (
+        pytest.approx(0.039) if profile is Profile.APM25 else 0.0
+    )
 
 
 @pytest.mark.parametrize("profile", [Profile.APM25, Profile.COPTER4])
@@ -193,7 +210,11 @@ def test_copter4_motors_stopped_2_s_after_arming_then_spool_over_mot_spool_time(
 
 
 # ---- 4. 4.x GCS failsafe defaults ------------------------------------------------------------
-def test_copter4_gcs_failsafe_off_by_default_then_fs_gcs_timeout_and_value_5_lands() -> None:
+def test_copter4_gcs_failsafe_off_by_default_then_value_5_continues_pilot_control() -> None:
+    """FS_GCS_ENABLE 0 by default; set to 5 (LAND) with FS_GCS_TIMEOUT 2, the 4.x default
+    FS_OPTIONS 16 ("continue in pilot-controlled modes") still keeps STABILIZE, and the failsafe
+    clears the overrides: the throttle is the receiver's 1000 µs and the vehicle falls, as the
+    real 4.7 did (fixtures' uplink-fade)."""
     _sim, gcs = make(Profile.COPTER4)
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.2)
@@ -213,10 +234,32 @@ def test_copter4_gcs_failsafe_off_by_default_then_fs_gcs_timeout_and_value_5_lan
     msgs = pilot.fly(1.9)
     assert not [t for t in _texts(gcs, msgs) if "Failsafe" in t]
     msgs = pilot.fly(0.3)
+    assert "GCS Failsafe - Continuing Pilot Control" in _texts(gcs, msgs)
+    msgs = pilot.fly(0.3)
+    assert gcs.of_type("SIM_STATE", msgs)[-1].vd > 0.5  # falling on the receiver's throttle
+    pilot.fly(0.7)
+    assert _hb(gcs)[:2] == (0, 209)  # still STABILIZE, armed
+
+
+def test_copter4_gcs_failsafe_5_lands_with_fs_options_0() -> None:
+    """What a station's --fix-failsafe sets on 4.x (FS_OPTIONS bit 4 off, FS_GCS_ENABLE 5,
+    FS_GCS_TIMEOUT 2 under RC_OVERRIDE_TIME): the GCS failsafe's LAND."""
+    _sim, gcs = make(Profile.COPTER4, seed=4)
+    _set(gcs, "FS_GCS_ENABLE", 5.0)  # 5 = LAND on 4.x
+    _set(gcs, "FS_GCS_TIMEOUT", 2.0)
+    _set(gcs, "FS_OPTIONS", 0.0)
+    pilot = Pilot(gcs)
+    take_off(gcs, pilot, 1.2)
+    pilot.sticks[2] = HOVER_STICK_US
+    pilot.fly(1.0)
+    pilot.overrides = pilot.heartbeats = False
+    msgs = pilot.fly(1.9)
+    assert not [t for t in _texts(gcs, msgs) if "Failsafe" in t]
+    msgs = pilot.fly(0.3)
     assert "GCS Failsafe" in _texts(gcs, msgs)
     pilot.fly(1.0)
     assert _hb(gcs) == (9, 209, 5)  # LAND, still armed, CRITICAL
-    assert truth_alt(gcs) > 0.4  # landing, not falling: the overrides had not lapsed yet
+    assert truth_alt(gcs) > 0.4  # landing, not falling
 
 
 def test_fs_gcs_timeout_is_clamped_to_its_range_and_3_2_1_keeps_5_s() -> None:
@@ -248,8 +291,13 @@ def test_disarm_delay_auto_disarms_on_the_floor() -> None:
 
 
 # ---- 5. when the overrides stop --------------------------------------------------------------
+NO_RECEIVER_NO_GPS = AutopilotOptions(rc_input=RcInput.ABSENT, gps=False)
+
+
 def test_apm25_radio_failsafe_lands_2_s_after_the_last_override_overrides_stay() -> None:
-    _sim, gcs = make(Profile.APM25)
+    """No receiver and no GPS: 2 s after the last override the radio failsafe lands (with a GPS
+    it would pick RTL; tests/sitl/test_failsafe_conformance.py)."""
+    _sim, gcs = make(Profile.APM25, options=NO_RECEIVER_NO_GPS)
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.2)
     pilot.sticks[2] = HOVER_STICK_US
@@ -277,8 +325,8 @@ def test_apm25_radio_failsafe_lands_2_s_after_the_last_override_overrides_stay()
 def test_apm25_radio_failsafe_land_levels_whatever_the_last_override_leant() -> None:
     """land_nogps_run takes no pilot roll, pitch or yaw under a radio failsafe: the dead
     uplink's last override, still on the radio, must not keep the vehicle leaning (it once
-    carried a landing vehicle into a wall and down a 0.45 m drop)."""
-    _sim, gcs = make(Profile.APM25)
+    carried a landing vehicle into a wall and down a 0.45 m drop). No receiver, no GPS."""
+    _sim, gcs = make(Profile.APM25, options=NO_RECEIVER_NO_GPS)
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.2)
     pilot.sticks[2] = HOVER_STICK_US

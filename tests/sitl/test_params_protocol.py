@@ -129,12 +129,13 @@ def test_request_list_delivers_every_parameter_once_with_index_and_count(
         )
         assert "RC_OVERRIDE_TIME" not in by_name
         assert 300 <= by_name["THR_MID"].param_value <= 700  # tuned to the airframe's hover
-        assert by_name["RNGFND_MIN_CM"].param_value == 2.0  # configured for the HC-SR04
+        assert by_name["RNGFND_MIN_CM"].param_value == 20.0  # the firmware's, as shipped
+        assert by_name["RNGFND_MAX_CM"].param_value == 400.0  # set for the HC-SR04
     else:
         assert texts[:2] == ["ArduCopter V4.7.0-dev (d2e4299f)", "Frame: QUAD/PLUS"]
         assert {"ATC_RAT_RLL_P", "PSC_POSZ_P", "PSC_ACCZ_I", "MOT_THST_HOVER"} <= set(by_name)
         assert by_name["RC_OVERRIDE_TIME"].param_value == 3.0
-        assert by_name["RNGFND1_MIN"].param_value == pytest.approx(0.02)
+        assert by_name["RNGFND1_MIN"].param_value == pytest.approx(0.2)  # the firmware's
 
 
 def test_apm25_parameter_download_takes_17_s_and_slows_the_streams_to_a_quarter() -> None:
