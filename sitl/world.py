@@ -6,6 +6,9 @@ knows: `[sensors.*]` (see sitl.sensor_params), `[vehicle]` (sitl.params.VehicleP
 
     [autopilot]  realistic_boot = true      # copter4: the real ≈ 24 s pre-arm delay
                  copter4_version = "4.6"    # parameter names of a 4.x before 4.7
+                 rc_input = "absent"        # the receiver: "min" (default), "mid", "absent"
+                 gps = true                 # a GPS fix with home (default none, as indoors)
+                 home_distance_m = 3.0      # how far the GPS puts the vehicle from home
     [autopilot.params]  FS_BATT_ENABLE = 1   # values the vehicle boots with (the profile's names)
 
 A bad file raises WorldError with one line: `<file>: <field>: <problem>`.
@@ -18,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sitl.autopilot.profile import AutopilotOptions
+from sitl.autopilot.profile import AutopilotOptions, RcInput
 from sitl.params import ParamError, VehicleParams, build_dataclass
 from sitl.sensor_params import SensorParams
 from worldfile import (
@@ -132,23 +135,37 @@ def world_from_spec(spec: WorldSpec) -> World:
 
 def _parse_autopilot(data: Any) -> AutopilotOptions:
     try:
-        data = table(data, "autopilot", {"realistic_boot", "copter4_version", "params"})
+        data = table(data, "autopilot", {"realistic_boot", "copter4_version", "params",
+                                         "rc_input", "gps", "home_distance_m"})
     except FieldError as exc:
         raise ParamError(str(exc)) from None
-    realistic = data.get("realistic_boot", False)
-    if not isinstance(realistic, bool):
-        raise ParamError(f"autopilot.realistic_boot: expected true or false, got {realistic!r}")
+    defaults = AutopilotOptions()
+    flags: dict[str, bool] = {}
+    for key in ("realistic_boot", "gps"):
+        flag = data.get(key, getattr(defaults, key))
+        if not isinstance(flag, bool):
+            raise ParamError(f"autopilot.{key}: expected true or false, got {flag!r}")
+        flags[key] = flag
+    receivers = [r.value for r in RcInput]
+    rc_input = data.get("rc_input", defaults.rc_input.value)
+    if rc_input not in receivers:
+        raise ParamError(f"autopilot.rc_input: expected one of {', '.join(receivers)}, "
+                         f"got {rc_input!r}")
     version = data.get("copter4_version", "4.7")
     values = data.get("params", {})
     if not isinstance(values, Mapping):
         raise ParamError(f"autopilot.params: expected a table, got {type(values).__name__}")
     try:
         params = [(str(k), number(v, f"autopilot.params.{k}")) for k, v in values.items()]
+        home_m = number(data.get("home_distance_m", defaults.home_distance_m),
+                        "autopilot.home_distance_m")
     except FieldError as exc:
         raise ParamError(str(exc)) from None
     try:
-        return AutopilotOptions(realistic_boot=realistic, copter4_version=str(version),
-                                params=tuple(params))
+        return AutopilotOptions(realistic_boot=flags["realistic_boot"],
+                                copter4_version=str(version), params=tuple(params),
+                                rc_input=RcInput(rc_input), gps=flags["gps"],
+                                home_distance_m=home_m)
     except ValueError as exc:
         raise ParamError(f"autopilot.{exc}") from None
 

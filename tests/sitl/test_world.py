@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from sitl.autopilot.profile import RcInput
 from sitl.world import FloorMaterial, WorldError, default_world, load_world
 
 WORLDS = Path(__file__).resolve().parents[2] / "worlds"
@@ -102,6 +103,17 @@ strength_cps = 2000.0
     assert w.background_cps == pytest.approx(20.0)  # 1 % of the strongest source
 
 
+def test_autopilot_table_sets_the_receiver_and_the_gps(tmp_path: Path) -> None:
+    """The failsafes' inputs (receiver, GPS fix, home distance) come from the world file; the
+    defaults are a receiver at minimum and no GPS fix (indoors)."""
+    plain = load_world(write(tmp_path, ROOM)).autopilot
+    assert (plain.rc_input, plain.gps) == (RcInput.MIN, False)
+    p = write(tmp_path, ROOM + '[autopilot]\nrc_input = "absent"\ngps = true\n'
+              "home_distance_m = 1.5\n")
+    a = load_world(p).autopilot
+    assert (a.rc_input, a.gps, a.home_distance_m) == (RcInput.ABSENT, True, 1.5)
+
+
 BAD = [
     (
         ROOM + '[[boxes]]\nname = "a"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n'
@@ -141,6 +153,10 @@ BAD = [
     (ROOM + "[vehicle]\nmass_kg = 0.1\n", "vehicle.motor_mass_kg"),
     (ROOM + "[mocap]\nenabled = 1\n", "mocap.enabled: expected true or false"),
     (ROOM + "[radiation]\nbackground_cps = -1\n", "radiation.background_cps"),
+    (ROOM + "[autopilot]\ngps = 1\n", "autopilot.gps: expected true or false, got 1"),
+    (ROOM + '[autopilot]\nrc_input = "none"\n',
+     "autopilot.rc_input: expected one of absent, min, mid, got 'none'"),
+    (ROOM + "[autopilot]\nhome_distance_m = -2\n", "autopilot.home_distance_m"),
     ("name = [unclosed\n", "not valid TOML"),
 ]
 
