@@ -13,6 +13,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -29,7 +30,7 @@ FIXED_4X = ("--fix-failsafe: set FS_GCS_ENABLE 0 -> 5, FS_GCS_TIMEOUT 5 -> 2, FS
 
 
 def quadgcs(*argv: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "gcs", "fly", "--no-record", "--hold", "1",
+    return subprocess.run([sys.executable, "-m", "lab", "fly", "--no-record", "--hold", "1",
                            "--seed", "4", *argv], capture_output=True, text=True, timeout=240,
                           cwd=ROOT)
 
@@ -44,9 +45,9 @@ def test_lockstep_copter4_defaults_are_refused_with_one_line() -> None:
     proc = quadgcs("--lockstep", "--profile", "copter4")
     assert proc.returncode != 0
     line = last_line(proc)
-    assert line.startswith("quadgcs fly: arm refused: FS_GCS_ENABLE 0: on a silent link the "
-                           "vehicle keeps flying on the receiver's throttle (no GCS failsafe); "
-                           "set FS_GCS_ENABLE 5 or pass --fix-failsafe"), line
+    assert line.startswith("quadgcs fly: arming: vehicle 1: arm refused: FS_GCS_ENABLE 0: on a "
+                           "silent link the vehicle keeps flying on the receiver's throttle (no "
+                           "GCS failsafe); set FS_GCS_ENABLE 5 or pass --fix-failsafe"), line
     assert "Traceback" not in proc.stderr
 
 
@@ -61,6 +62,24 @@ def test_lockstep_apm25_without_gps_lands_by_itself_and_needs_no_fix() -> None:
     proc = quadgcs("--lockstep", "--profile", "apm25")
     assert proc.returncode == 0, proc.stderr
     assert "--fix-failsafe:" not in proc.stderr
+
+
+def test_lockstep_apm25_with_gps_is_refused_then_fixed_to_rtl_at_its_height(
+        tmp_path: Path) -> None:
+    # 3.2.1 with a GPS fix: its GCS failsafe's RTL climbs to RTL_ALT (15 m) before it returns
+    world = tmp_path / "gps.toml"
+    world.write_text((ROOT / "worlds" / "empty_room.toml").read_text()
+                     + "\n[autopilot]\ngps = true\n")
+    refused = quadgcs("--lockstep", "--profile", "apm25", "--world", str(world))
+    assert refused.returncode != 0
+    line = last_line(refused)
+    assert line.startswith("quadgcs fly: arming: vehicle 1: arm refused: RTL_ALT 1500: on a "
+                           "silent link the vehicle after 5 s climbs to RTL_ALT 15 m in RTL "
+                           "(GPS 3D fix); set RTL_ALT 0 (return at the current height) or pass "
+                           "--fix-failsafe"), line
+    fixed = quadgcs("--lockstep", "--profile", "apm25", "--world", str(world), "--fix-failsafe")
+    assert fixed.returncode == 0, fixed.stderr
+    assert "RTL_ALT 1500 -> 0" in fixed.stderr
 
 
 @pytest.fixture
