@@ -38,7 +38,7 @@ from firmware_link import (
 from firmware_link.params import check_param_name
 from gcs.errors import RuntimeFault, UsageError
 from gcs.sitl_process import SitlOptions, SitlProcess
-from worldfile import load_signing_key
+from gcs.toml_file import read_signing_key
 
 # Names that moved between firmware versions: a pilot's habit from one meets the other.
 RENAMED = {
@@ -124,18 +124,9 @@ def _check_writable(path: Path) -> None:
         raise UsageError(f"save {path}: no such directory {parent}")
 
 
-def _key(path: Path | None) -> bytes | None:
-    if path is None:
-        return None
-    try:
-        return load_signing_key(path)
-    except (LinkUsageError, OSError, ValueError) as exc:
-        raise UsageError(f"--signing-key {path}: {exc}") from None
-
-
 @contextlib.contextmanager
 def _vehicle(args: argparse.Namespace) -> Iterator[VehicleLink]:
-    key = _key(args.signing_key)
+    key = read_signing_key(args.signing_key)
     if args.world is not None and not args.world.is_file():
         raise UsageError(f"--world {args.world}: no such file")
     with contextlib.ExitStack() as stack:

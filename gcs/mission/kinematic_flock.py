@@ -14,18 +14,16 @@ the planner first says it arrived.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from gcs.mission.kinematic_port import KinematicPort
-from gcs.mission.kinematic_runs import scene_setup
+from gcs.mission.kinematic_runs import scene_setup, scene_spec
 from gcs.mission.loop_flock import fly_flock
 from gcs.mission.recording import MissionRecording
 from gcs.mission.report import MissionStatus
-from gcs.mission.spec import MissionSpec, PlannerKind, VehicleSpec
+from gcs.mission.spec import MissionSpec, PlannerKind
 from planners.flocking.scenes import FlockScene
 from planners.flocking.separation import VEHICLE_COLLISION_M
 from planners.flocking.swarm import FlockPlannerKind, PlannerFactory, factory_for
@@ -158,12 +156,8 @@ def fly_flock_scene(scene: FlockScene, n_vehicles: int,
             raise ValueError(
                 f"scene {scene.name!r}: vehicle {vid} would start at {p}, inside an obstacle")
     sims = {v: KinematicSim(scene.world, starts[v], prm.body, prm.proximity, rng) for v in ids}
-    spec = MissionSpec(path=Path(f"<{scene.name}>"), name=scene.name, world_path=None,
-                       vehicles=tuple(VehicleSpec(v, starts[v]) for v in ids),
-                       takeoff_alt_m=-scene.leader_start_n[2], planner=PlannerKind.FLOCKING,
-                       planner_params={}, goals_n=(scene.common_goal_n,),
-                       goal_tolerance_m=math.inf, land=False, max_duration_s=math.inf,
-                       profile="apm25")
+    spec = scene_spec(PlannerKind.FLOCKING, scene.name, {v: starts[v] for v in ids},
+                      (scene.common_goal_n,))
     port = _ScenePort(spec, sims, scene, prm, rng)
     outcome = fly_flock(port, scene_setup(None, max_steps), starts, plan)
     m = outcome.metrics

@@ -37,13 +37,16 @@ SYSID = 1
 START_BLOCKED = "start is inside an obstacle or outside the room"
 
 
-def scene_spec(planner: PlannerKind, name: str, start_n: Vec3, goals_n: tuple[Vec3, ...],
-               goal_tolerance_m: float = math.inf) -> MissionSpec:
-    """A one-vehicle mission on a scene given in code (no file, no world file, no budget).
+def scene_spec(planner: PlannerKind, name: str, starts_n: dict[int, Vec3],
+               goals_n: tuple[Vec3, ...], goal_tolerance_m: float = math.inf) -> MissionSpec:
+    """A mission on a scene given in code (no file, no world file, no time budget): its
+    vehicles where they start, the lead vehicle first, at the lead vehicle's height.
 
     The default tolerance leaves "reached" to the planner, as the thesis's runs do."""
+    lead = next(iter(starts_n.values()))
     return MissionSpec(path=Path(f"<{name}>"), name=name, world_path=None,
-                       vehicles=(VehicleSpec(SYSID, start_n),), takeoff_alt_m=-start_n[2],
+                       vehicles=tuple(VehicleSpec(v, p) for v, p in starts_n.items()),
+                       takeoff_alt_m=-lead[2],
                        planner=planner, planner_params={}, goals_n=goals_n,
                        goal_tolerance_m=goal_tolerance_m, land=False, max_duration_s=math.inf,
                        profile="apm25")
@@ -144,7 +147,7 @@ def fly_epbha_scene(world: World, start_n: Vec3, goal_n: Vec3,
     proximity = proximity or ProximityParams(range_m=params.sensor_range_m,
                                              cone_deg=params.sensor_cone_deg, exact=True)
     sim = KinematicSim(world, start_n, body, proximity, rng)
-    spec = scene_spec(PlannerKind.EPBHA, "epbha", start_n, (goal_n,))
+    spec = scene_spec(PlannerKind.EPBHA, "epbha", {SYSID: sim.pos_n}, (goal_n,))
     port = _TimedPort(spec, {SYSID: sim}, params.step_m, cpu_clock)
     outcome = fly_epbha(port, scene_setup(params, max_steps), sim.pos_n)
     port.lap()
@@ -169,7 +172,7 @@ def fly_radiation_field(field: RadiationField, params: RadiationMapperParams | N
     start: Vec3 = (float(xy[0]), float(xy[1]), -alt)
     room = Box("floor", (p.x_min_m, p.y_min_m, -2.0 * alt), (p.x_max_m, p.y_max_m, 0.0))
     sim = KinematicSim(World(room), start)
-    spec = scene_spec(PlannerKind.RADIATION, "radiation", start, ())
+    spec = scene_spec(PlannerKind.RADIATION, "radiation", {SYSID: start}, ())
     port = KinematicPort(spec, MissionRecording(None), {SYSID: sim}, 0.0, field=field, rng=rng)
     mapper = RadiationMapper(p, max_samples=max_samples)
     outcome = fly_radiation(port, scene_setup(p, max_samples=max_samples), start, None, mapper)

@@ -19,7 +19,6 @@ from typing import Any
 
 from firmware_link import (
     Forwarder,
-    LinkUsageError,
     MocapLink,
     ParamError,
     VehicleLink,
@@ -39,7 +38,7 @@ from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlOptions, SitlProcess
 from gcs.station.guardian import Guardian, GuardianSetup
 from gcs.station.station import Station
-from worldfile import load_signing_key
+from gcs.toml_file import read_signing_key
 
 CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
 STREAM_RATE_HZ = 40.0
@@ -195,13 +194,7 @@ class StationSession:
         return self.vehicles[self.options.sysids[0]]
 
     def _key(self) -> bytes | None:
-        path = self.options.signing_key
-        if path is None:
-            return None
-        try:
-            return load_signing_key(path)
-        except (LinkUsageError, OSError, ValueError) as exc:
-            raise UsageError(f"--signing-key {path}: {exc}") from None
+        return read_signing_key(self.options.signing_key)
 
     def _open(self) -> None:
         o = self.options
