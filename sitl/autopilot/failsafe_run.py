@@ -3,9 +3,10 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from sitl.autopilot.arming import Severity
+from sitl.autopilot.failsafe import BatteryWatch, GcsWatch, RadioWatch, ThrottleLowWatch
 from sitl.autopilot.failsafe_rules import (
     Decision,
     Response,
@@ -15,11 +16,37 @@ from sitl.autopilot.failsafe_rules import (
     radio_apm25,
     radio_copter4,
 )
-from sitl.autopilot.params import Key
-from sitl.autopilot.profile import FlightMode, Profile, RcInput
+from sitl.autopilot.land_detector import LandDetector
+from sitl.autopilot.params import Key, ParamStore
+from sitl.autopilot.profile import AutopilotOptions, FlightMode, Profile, RcInput
+from sitl.autopilot.radio import Radio
+from sitl.autopilot.state import AutopilotState
 
-if TYPE_CHECKING:
-    from sitl.autopilot.autopilot import Autopilot
+
+class Autopilot(Protocol):
+    """What the failsafes read and act on of `sitl.autopilot.autopilot.Autopilot` (a protocol,
+    so that this module and the autopilot that runs it do not import each other)."""
+
+    profile: Profile
+    options: AutopilotOptions
+    params: ParamStore
+    state: AutopilotState
+    radio: Radio
+    land: LandDetector
+    gcs: GcsWatch
+    radio_watch: RadioWatch
+    throttle_low: ThrottleLowWatch
+    battery: BatteryWatch
+    throttle_up_s: float
+    texts: list[tuple[int, str]]
+
+    def throttle_stick(self) -> float: ...
+
+    def enter_mode(self, mode: FlightMode) -> None: ...
+
+    def land_with_pause(self) -> None: ...
+
+    def force_disarm(self) -> None: ...
 
 THROTTLE_ZERO_DEBOUNCE_S = 0.4  # 4.x THROTTLE_ZERO_DEBOUNCE_TIME_MS
 
