@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from types import FrameType
 
 from sitl.autopilot import Profile
-from sitl.autopilot.profile import COPTER4_VERSIONS
+from sitl.autopilot.profile import COPTER4_VERSIONS, RcInput
 from sitl.link.codec import SigningKeyError, load_signing_key
 from sitl.link.endpoints import EndpointError
 from sitl.link.server import TCP_BASE_PORT, EndpointPlan, SitlServer
@@ -63,6 +63,16 @@ def _positive(text: str) -> float:
         raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
     if not value > 0.0 or value != value:
         raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
+def _distance(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected metres >= 0, got {text!r}") from None
+    if not value >= 0.0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected metres >= 0, got {text!r}")
     return value
 
 
@@ -120,6 +130,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "4.x before 4.7 (SYSID_MYGCS, SRn_*); also [autopilot] copter4_version",
     )
     parser.add_argument(
+        "--rc-input",
+        choices=[r.value for r in RcInput],
+        help="the vehicles' RC receiver: min = present, throttle at 1000 µs (the real "
+        "simulators' default and ours), mid = present, throttle at 1500 µs, absent = none "
+        "(the radio failsafe acts when the overrides stop)",
+    )
+    parser.add_argument(
+        "--no-gps",
+        action="store_true",
+        help="no GPS fix: RTL is refused and every RTL-like failsafe lands (default: a fix "
+        "with home set, as the real simulators have)",
+    )
+    parser.add_argument(
+        "--home-distance",
+        type=_distance,
+        metavar="M",
+        help="how far from home the GPS puts the vehicle (default 3 m; over WPNAV_RADIUS "
+        "2 m, 3.2.1's GCS failsafe picks RTL, else LAND)",
+    )
+    parser.add_argument(
         "--truth-port",
         type=_port,
         metavar="PORT",
@@ -162,12 +192,16 @@ What a ground station sees:
                   vehicle: LOCAL_POSITION_NED at 50 Hz, z from the floor, time_boot_ms =
                   simulated time (sitl/truth_server.py), for scoring only.
   serial port     MAVLink 1 frames (apm25) carry base payloads only, as a real v1 sender.
-  failsafes       apm25: FS_GCS_ENABLE 1, 5 s after the last heartbeat or override while
-                  overrides are in use; radio failsafe 2 s after the last override (no
-                  receiver, FS_THR_ENABLE 1): LAND. FS_GCS_ENABLE 3 (this SITL): hold
-                  altitude until the battery failsafe, then land. copter4: FS_GCS_ENABLE 0
-                  (no GCS failsafe), FS_GCS_TIMEOUT 5 s; overrides lapse after
-                  RC_OVERRIDE_TIME 3 s to the radio's 1000 µs throttle.
+  failsafes       as the real firmware (sitl/README.md). apm25: FS_GCS_ENABLE 1, 5 s
+                  after the last heartbeat or override while overrides are in use: RTL
+                  (climbs to RTL_ALT 15 m) with GPS and home over 2 m away, else LAND;
+                  overrides never lapse while a receiver is present; --rc-input absent:
+                  radio failsafe 2 s after the last override. copter4: FS_GCS_ENABLE 0
+                  (none); when set, FS_OPTIONS 16 keeps STABILIZE/ALT_HOLD going ("GCS
+                  Failsafe - Continuing Pilot Control") with the overrides cleared:
+                  throttle to the receiver's 1000 µs. Overrides lapse after
+                  RC_OVERRIDE_TIME 3 s; --rc-input absent: radio failsafe after
+                  RC_FS_TIMEOUT 1 s (RTL with GPS, else LAND).
 """
 
 
@@ -203,6 +237,11 @@ def _server_from_args(args: argparse.Namespace) -> SitlServer:
             opts,
             realistic_boot=opts.realistic_boot or args.realistic_boot,
             copter4_version=args.copter4_version or opts.copter4_version,
+            rc_input=RcInput(args.rc_input) if args.rc_input else opts.rc_input,
+            gps=opts.gps and not args.no_gps,
+            home_distance_m=(
+                opts.home_distance_m if args.home_distance is None else args.home_distance
+            ),
         )
     except ValueError as exc:
         raise CliError(str(exc), 2) from None

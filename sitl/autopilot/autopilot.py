@@ -1,7 +1,8 @@
-"""The autopilot of one simulated vehicle: ArduCopter's STABILIZE, ALT_HOLD and LAND, arming,
-radio with GCS overrides, GCS, radio and battery failsafes, 4.x motor spool-up. Pure: sensors
-and time go in, motor outputs come out; the MAVLink side lives in `sitl.link`. The per-firmware
-rules and the facts behind them are in `arming.py`, `failsafe.py` and `spool.py`.
+"""The autopilot of one simulated vehicle: ArduCopter's STABILIZE, ALT_HOLD, LAND and (with a
+GPS) RTL / SmartRTL, arming, radio with GCS overrides, GCS, radio and battery failsafes, 4.x
+motor spool-up. Pure: sensors and time go in, motor outputs come out; the MAVLink side lives in
+`sitl.link`. The per-firmware rules and the facts behind them are in `arming.py`,
+`failsafe.py`, `failsafe_rules.py`, `rtl.py` and `spool.py`.
 """
 
 from __future__ import annotations
@@ -14,7 +15,8 @@ from sitl.autopilot.ahrs import GRAVITY_MSS, Ahrs
 from sitl.autopilot.alt_hold import AltitudeController, SurfaceTracker
 from sitl.autopilot.arming import CommandResult, MavResult, Severity
 from sitl.autopilot.attitude import AttitudeController
-from sitl.autopilot.failsafe import BatteryWatch, GcsFailsafeAction, GcsWatch, RadioWatch
+from sitl.autopilot.failsafe import BatteryWatch, GcsWatch, RadioWatch
+from sitl.autopilot.failsafe_run import run_failsafes
 from sitl.autopilot.gains import Gains
 from sitl.autopilot.inertial_nav import InertialNavZ
 from sitl.autopilot.land_detector import LandDetector
@@ -27,6 +29,7 @@ from sitl.autopilot.profile import (
     Profile,
 )
 from sitl.autopilot.radio import Radio
+from sitl.autopilot.rtl import Rtl, RtlParams
 from sitl.autopilot.spool import Spool
 from sitl.autopilot.state import AutopilotState, SensorSample, SystemStatus
 from sitl.autopilot.throttle_curve import (
@@ -58,7 +61,8 @@ class Autopilot:
             params.set_key(Key.THR_HOVER, hover_throttle)
         self._param_version = -1
         self.gains = Gains.from_params(params)
-        self.radio = Radio(profile)
+        self.radio = Radio(profile, self.options.rc_input)
+        self.rtl = Rtl()
         self.ahrs = Ahrs()
         self.inav = InertialNavZ(self.gains.inav_tc_z_s)
         self.attitude = AttitudeController(self.gains)
@@ -106,16 +110,21 @@ class Autopilot:
                             for key in (Key.RC1_DZ, Key.RC2_DZ, Key.RC3_DZ, Key.RC4_DZ))
         self._thr_hover_param = k(Key.THR_HOVER)
         self._thr_min_param = k(Key.THR_MIN)
-        self._fs_gcs = GcsFailsafeAction.from_param(k(Key.FS_GCS_ENABLE), apm)
-        self._fs_thr_enabled = k(Key.FS_THR_ENABLE) > 0
-        self._fs_batt_enabled = k(Key.FS_BATT_ENABLE) > 0
-        self._fs_batt_voltage = k(Key.FS_BATT_VOLTAGE)
+        self._rtl_params = RtlParams(
+            rtl_alt_cm=k(Key.RTL_ALT_CM),
+            loiter_ms=k(Key.RTL_LOIT_TIME_MS),
+            speed_cms=k(Key.WP_SPEED_CMS),
+            speed_up_cms=k(Key.WP_SPEED_UP_CMS),
+            speed_dn_cms=k(Key.WP_SPEED_DN_CMS),
+            land_speed_cms=k(Key.LAND_SPEED),
+            home_distance_m=self.options.home_distance_m,
+        )
         self.attitude.set_gains(self.gains)
         self.alt_ctrl.set_gains(self.gains)
         self.inav.tc_z_s = self.gains.inav_tc_z_s
 
     # ---- sticks ----------------------------------------------------------------------------
-    def _throttle_stick(self) -> float:
+    def throttle_stick(self) -> float:
         """Throttle channel as control_in, 0..1000, with the bottom dead zone."""
         pwm = self.radio.channel(2)
         dz = self._dz_us[2]
@@ -141,7 +150,7 @@ class Autopilot:
     def _pilot_climb_cms(self) -> float:
         g = self.gains
         return climb_rate_from_stick(
-            self._throttle_stick(), g.thr_dz, g.pilot_velz_max_cms, g.pilot_velz_max_cms
+            self.throttle_stick(), g.thr_dz, g.pilot_velz_max_cms, g.pilot_velz_max_cms
         )
 
     # ---- GCS-facing commands --------------------------------------------------------------
@@ -156,30 +165,37 @@ class Autopilot:
         self.gcs_seen(t_s)
 
     def set_mode(self, number: int) -> CommandResult:
-        """Change flight mode as ArduCopter's set_mode would."""
+        """Change flight mode as ArduCopter's set_mode would (RTL and SmartRTL need a GPS)."""
         try:
             mode = FlightMode(number)
         except ValueError:
+            mode = None
+        needs_gps = mode in (FlightMode.RTL, FlightMode.SMART_RTL)
+        if (mode is None or (needs_gps and not self.options.gps)
+                or (mode is FlightMode.SMART_RTL and self.profile is Profile.APM25)):
             name = KNOWN_UNSUPPORTED_MODES.get(number, str(number))
             text = None if self.profile is Profile.APM25 else "Flight mode change failed"
             return CommandResult(False, text if name else None, MavResult.FAILED)
         if mode is not self.state.mode:
-            self._enter_mode(mode)
+            self.enter_mode(mode)
         return CommandResult(True)
 
-    def _land_with_pause(self) -> None:
+    def land_with_pause(self) -> None:
         """A failsafe's LAND (set_mode_land_with_pause, both firmwares): hold the height for
         LAND_WITH_DELAY_MS (4 s), so a pilot can take over, then descend."""
-        self._enter_mode(FlightMode.LAND)
+        self.enter_mode(FlightMode.LAND)
         self._land_pause_until_s = self._t_s + LAND_PAUSE_S
 
-    def _enter_mode(self, mode: FlightMode) -> None:
-        if mode in (FlightMode.ALT_HOLD, FlightMode.LAND):
+    def enter_mode(self, mode: FlightMode) -> None:
+        """Switch to `mode` (the controllers start from the current height and climb)."""
+        if mode is not FlightMode.STABILIZE:
             self.alt_ctrl.reset(
                 self.inav.alt_m * 100.0, self._last_throttle, self.inav.climb_ms * 100.0
             )
+        if mode in (FlightMode.RTL, FlightMode.SMART_RTL):
+            self.rtl.start(self.inav.alt_m * 100.0, self._t_s, self._rtl_params,
+                           smart=mode is FlightMode.SMART_RTL)
         self.state.mode = mode
-        self.state.hold_for_gcs = False
         self._land_pause_until_s = 0.0
 
     @property
@@ -195,7 +211,7 @@ class Autopilot:
             return CommandResult(True)
         st = self.state
         if st.mode is FlightMode.STABILIZE:
-            throttle_up = self._throttle_stick() > 0.0
+            throttle_up = self.throttle_stick() > 0.0
         else:
             throttle_up = self._pilot_climb_cms() > 0.0
         refusal = arming.arm_check(
@@ -229,6 +245,10 @@ class Autopilot:
             return refusal
         self._disarm()
         return CommandResult(True)
+
+    def force_disarm(self) -> None:
+        """Disarm whatever the mode (a failsafe's disarm)."""
+        self._disarm()
 
     def _disarm(self) -> None:
         self.state.armed = False
@@ -273,7 +293,7 @@ class Autopilot:
 
         # 4.x drops overrides after RC_OVERRIDE_TIME (0 = never, 3.2.1's behaviour)
         self.radio.expire(t_s, self._rc_override_time_s)
-        self._failsafes(t_s, s.battery_v)
+        run_failsafes(self, t_s, s.battery_v, self._gcs_timeout_s)
 
         throttle, t_roll, t_pitch, yaw_rate = self._run_mode(dt_s, acc_up, tilt_cos)
         if self.profile is Profile.COPTER4:
@@ -346,11 +366,13 @@ class Autopilot:
         t_pitch = self._angle(1)
         yaw_rate = self._yaw_rate()
         # LAND without GPS takes no pilot input under a radio failsafe (land_nogps_run: `if
-        # (!failsafe.radio)`): a dead uplink's last override must not keep the vehicle leaning
-        if st.hold_for_gcs or (st.mode is FlightMode.LAND and st.radio_failsafe):
+        # (!failsafe.radio)`): a dead uplink's last override must not keep the vehicle leaning;
+        # RTL and SmartRTL fly themselves
+        rtl = st.mode in (FlightMode.RTL, FlightMode.SMART_RTL)
+        if rtl or (st.mode is FlightMode.LAND and st.radio_failsafe):
             t_roll = t_pitch = yaw_rate = 0.0
         if st.mode is FlightMode.STABILIZE:
-            stick = self._throttle_stick()
+            stick = self.throttle_stick()
             self._want_thrust = stick > 0.0
             if not c4:
                 thr = throttle_apm25(stick, self._thr_hover_param, self._thr_min_param)
@@ -359,8 +381,22 @@ class Autopilot:
             if not st.armed:
                 self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
             return thr, t_roll, t_pitch, yaw_rate
+        if rtl:
+            climb = self.rtl.climb_rate(self.inav.alt_m * 100.0, self._t_s, self._rtl_params)
+            self._want_thrust = climb > 0.0 or not self.land.landed
+            if not st.armed or (self.land.landed and climb <= 0.0):
+                self.alt_ctrl.reset(self.inav.alt_m * 100.0, 0.0)
+                return 0.0, t_roll, t_pitch, yaw_rate
+            if self.land.landed and self._last_throttle <= 0.0:
+                self.alt_ctrl.init_takeoff(self.inav.alt_m * 100.0)
+            out = self.alt_ctrl.update(
+                climb, self.inav.alt_m * 100.0, self.inav.climb_ms * 100.0, acc_up * 100.0,
+                dt_s, tilt_cos,
+            )
+            self.alt_ctrl.learn_hover(out.throttle * tilt_cos, self.inav.climb_ms, dt_s)
+            return out.throttle, t_roll, t_pitch, yaw_rate
         if st.mode is FlightMode.ALT_HOLD:
-            climb = 0.0 if st.hold_for_gcs else self._pilot_climb_cms()
+            climb = self._pilot_climb_cms()
             self._want_thrust = climb > 0.0 or not self.land.landed
             # 4.x takes off only once the motors have spooled up (takeoff.triggered)
             waiting = c4 and self.land.landed and not self.spool.unlimited
@@ -405,10 +441,13 @@ class Autopilot:
             low, self.inav.climb_ms, throttle, self.alt_ctrl.hover_throttle, dt_s
         )
         st.landed = self.land.landed
-        stick_zero = self._throttle_stick() <= 0.0
+        stick_zero = self.throttle_stick() <= 0.0
         # 3.2.1 (LAND_REQUIRE_MIN_THROTTLE_TO_DISARM) waits for the stick or the radio failsafe
         disarm_ok = self.profile is Profile.COPTER4 or stick_zero or st.radio_failsafe
-        if st.mode is FlightMode.LAND and self.land.landed and disarm_ok:
+        landing = st.mode is FlightMode.LAND or (
+            st.mode in (FlightMode.RTL, FlightMode.SMART_RTL) and self.rtl.landing
+        )
+        if landing and self.land.landed and disarm_ok:
             self._disarm()
             return
         if touched:
@@ -420,64 +459,6 @@ class Autopilot:
                 self._disarm()
         else:
             self._zero_throttle_s = 0.0
-
-    def _failsafe_action(self, stick_zero: bool) -> None:
-        """What both firmwares do on a radio or GCS failsafe without GPS (RTL cannot, lands)."""
-        st = self.state
-        if not st.armed:
-            return
-        if self.land.landed or (st.mode is FlightMode.STABILIZE and stick_zero):
-            self._disarm()
-        elif st.mode is not FlightMode.LAND:
-            self._land_with_pause()
-
-    def _failsafes(self, t_s: float, battery_v: float) -> None:
-        st = self.state
-        apm = self.profile is Profile.APM25
-        # the throttle as the failsafe code sees it, before the overrides are cleared
-        stick_zero = self._throttle_stick() <= 0.0
-        if apm and self._fs_thr_enabled:
-            change = self.radio_watch.check(t_s, st.armed)
-            if change is True:
-                st.radio_failsafe = True
-                self._failsafe_action(stick_zero)
-            elif change is False:
-                st.radio_failsafe = False
-        elif st.radio_failsafe:
-            st.radio_failsafe = self.radio_watch.active = False
-        action = self._fs_gcs
-        change = None
-        if (st.armed and action is not GcsFailsafeAction.DISABLED) or self.gcs.active:
-            change = self.gcs.check(
-                t_s,
-                requires_override=apm,
-                override_active=self.radio.overridden,
-                timeout_s=self._gcs_timeout_s,
-            )
-        if change is True:
-            st.gcs_failsafe = True
-            self.radio.clear_overrides()
-            if not apm:
-                self.texts.append((int(Severity.WARNING), "GCS Failsafe"))
-            if action is GcsFailsafeAction.HOLD_THEN_LAND and apm and not self.land.landed:
-                if st.mode is not FlightMode.LAND:
-                    self._enter_mode(FlightMode.ALT_HOLD)
-                    st.hold_for_gcs = True
-            elif not (action is GcsFailsafeAction.CONTINUE and apm and st.mode is FlightMode.LAND):
-                self._failsafe_action(stick_zero)
-        elif change is False:
-            st.gcs_failsafe = False
-            st.hold_for_gcs = False
-            if not apm:
-                self.texts.append((int(Severity.INFO), "GCS Failsafe Cleared"))
-        if self._fs_batt_enabled and self.battery.check(t_s, battery_v, self._fs_batt_voltage):
-            st.battery_failsafe = True
-            self.texts.append((int(Severity.CRITICAL), f"Battery failsafe: {battery_v:.2f}V"))
-            if st.armed:
-                if self.land.landed:
-                    self._disarm()
-                elif st.mode is not FlightMode.LAND:
-                    self._land_with_pause()
 
     @property
     def booting(self) -> bool:

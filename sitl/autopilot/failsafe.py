@@ -1,45 +1,24 @@
-"""GCS, radio and battery failsafe timers (pure: time passed in).
+"""GCS, radio and battery failsafe timers (pure: time passed in). What a failsafe then does is
+in `failsafe_rules.py`.
 
 - GCS failsafe: 3.2.1 fires 5 s (fixed FS_GCS_TIMEOUT_MS) after the last GCS heartbeat or RC
-  override (both reset the timer), only while overrides are in use; 4.x fires FS_GCS_TIMEOUT
-  after the last heartbeat or override from MAV_GCS_SYSID once the GCS has been seen. Both only
-  while armed, and only when FS_GCS_ENABLE is not 0 (4.x's default is 0: no GCS failsafe).
-- Radio failsafe (3.2.1, FS_THR_ENABLE): with no RC receiver the only radio input is the GCS's
-  overrides, so `read_radio()` sees no new frame 2 s (FAILSAFE_RADIO_TIMEOUT_MS) after the last
-  override and sets failsafe.radio. A vehicle without overrides ever has no input to lose.
+  override (both reset the timer), only while overrides are in use and armed; 4.x fires
+  FS_GCS_TIMEOUT after the last heartbeat or override from MAV_GCS_SYSID once the GCS has been
+  seen, armed or not (disarmed it only announces). Only when FS_GCS_ENABLE is not 0 (4.x's
+  default is 0: no GCS failsafe).
+- Radio failsafe (FS_THR_ENABLE) with no RC receiver: the only radio input is the GCS's
+  overrides, so `read_radio()` sees no new frame RC_FS_TIMEOUT (4.x, 1 s) or
+  FAILSAFE_RADIO_TIMEOUT_MS (3.2.1, 2 s) after the last override. With a receiver whose
+  throttle stays above FS_THR_VALUE (975 µs) it never fires. A vehicle without overrides ever
+  has no input to lose.
 """
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
 GCS_TIMEOUT_S = 5.0  # 3.2.1's fixed FS_GCS_TIMEOUT_MS; 4.x's FS_GCS_TIMEOUT default
-RADIO_TIMEOUT_S = 2.0  # 3.2.1 FAILSAFE_RADIO_TIMEOUT_MS
 BATT_LOW_TIMER_S = 10.0  # voltage must stay low this long (BATT_LOW_TIMER)
-
-
-class GcsFailsafeAction(enum.IntEnum):
-    """FS_GCS_ENABLE values (without GPS every RTL-like action becomes LAND)."""
-
-    DISABLED = 0
-    LAND = 1  # RTL in both firmwares; without GPS it lands
-    CONTINUE = 2  # continue a mission in AUTO, else RTL (lands)
-    HOLD_THEN_LAND = 3  # on 3.2.1 this SITL's own option; on 4.x SmartRTL or RTL (lands)
-    SMART_RTL_OR_LAND = 4  # 4.x only
-    LAND_NOW = 5  # 4.x only: LAND
-
-    @classmethod
-    def from_param(cls, value: float, apm25: bool) -> GcsFailsafeAction:
-        """The action a parameter value asks for; unknown values act as LAND (not disabled)."""
-        v = int(value)
-        if v == 0:
-            return cls.DISABLED
-        if apm25:
-            return cls(v) if v in (1, 2, 3) else cls.LAND
-        if 1 <= v <= 5:
-            return cls(v) if v != 3 else cls.LAND  # 4.x's 3 is SmartRTL→RTL: lands here
-        return cls.LAND
 
 
 @dataclass
@@ -81,7 +60,7 @@ class GcsWatch:
 
 @dataclass
 class RadioWatch:
-    """3.2.1's radio failsafe with no receiver: new radio input comes only from overrides."""
+    """The radio failsafe with no receiver: new radio input comes only from overrides."""
 
     last_input_s: float | None = None
     active: bool = False
@@ -90,11 +69,11 @@ class RadioWatch:
         """An override arrived (a new radio frame as far as `read_radio()` is concerned)."""
         self.last_input_s = t_s
 
-    def check(self, t_s: float, armed: bool) -> bool | None:
+    def check(self, t_s: float, armed: bool, timeout_s: float) -> bool | None:
         """True on the tick the failsafe starts, False when input returns, else None."""
         if self.last_input_s is None:
             return None
-        late = t_s - self.last_input_s >= RADIO_TIMEOUT_S
+        late = t_s - self.last_input_s >= timeout_s
         if late and not self.active and armed:
             self.active = True
             return True

@@ -17,8 +17,7 @@ airframe's hover throttle, and the rangefinder limits from the world's sonar (an
 the firmware's default, including the ones that make a station's pre-flight checks matter:
 3.2.1 FS_GCS_ENABLE 1, FS_THR_ENABLE 1, FS_BATT_ENABLE 0; 4.7 FS_GCS_ENABLE 0, FS_GCS_TIMEOUT 5,
 BATT_FS_LOW_ACT 0, RC_OVERRIDE_TIME 3, DISARM_DELAY 10, MOT_SPOOL_TIME 0.5. FS_GCS_ENABLE 3 on
-3.2.1 (not a 3.2.1 value) is this SITL's own option: hold altitude while the GCS is silent and
-land when the battery failsafe trips.
+3.2.1 is not a 3.2.1 value: 3.2.1 treats it as 1 (RTL), as the real firmware does.
 """
 
 from __future__ import annotations
@@ -99,6 +98,15 @@ class Key(enum.Enum):
     RC2_DZ = enum.auto()
     RC3_DZ = enum.auto()
     RC4_DZ = enum.auto()
+    FS_OPTIONS = enum.auto()  # 4.x bit mask; 3.2.1 has none (0)
+    FS_THR_VALUE = enum.auto()
+    RADIO_TIMEOUT_S = enum.auto()  # 4.x RC_FS_TIMEOUT; 3.2.1's fixed 2 s
+    RTL_ALT_CM = enum.auto()
+    RTL_LOIT_TIME_MS = enum.auto()
+    WP_RADIUS_CM = enum.auto()
+    WP_SPEED_CMS = enum.auto()
+    WP_SPEED_UP_CMS = enum.auto()
+    WP_SPEED_DN_CMS = enum.auto()
 
 
 @dataclass(frozen=True)
@@ -146,6 +154,13 @@ _APM25_KEYS: dict[Key, tuple[str, float]] = {
     Key.LAND_SPEED: ("LAND_SPEED", 1.0),
     Key.BATT_CAPACITY: ("BATT_CAPACITY", 1.0),
     Key.SPIN_ARM: ("MOT_SPIN_ARMED", 0.001),
+    Key.FS_THR_VALUE: ("FS_THR_VALUE", 1.0),
+    Key.RTL_ALT_CM: ("RTL_ALT", 1.0),
+    Key.RTL_LOIT_TIME_MS: ("RTL_LOIT_TIME", 1.0),
+    Key.WP_RADIUS_CM: ("WPNAV_RADIUS", 1.0),
+    Key.WP_SPEED_CMS: ("WPNAV_SPEED", 1.0),
+    Key.WP_SPEED_UP_CMS: ("WPNAV_SPEED_UP", 1.0),
+    Key.WP_SPEED_DN_CMS: ("WPNAV_SPEED_DN", 1.0),
     **{getattr(Key, f"RC{n}_DZ"): (f"RC{n}_DZ", 1.0) for n in (1, 2, 3, 4)},
 }
 
@@ -185,6 +200,15 @@ _COPTER4_KEYS: dict[Key, tuple[str, float]] = {
     Key.DISARM_DELAY_S: ("DISARM_DELAY", 1.0),
     Key.SPOOL_TIME_S: ("MOT_SPOOL_TIME", 1.0),
     Key.SPIN_ARM: ("MOT_SPIN_ARM", 1.0),
+    Key.FS_OPTIONS: ("FS_OPTIONS", 1.0),
+    Key.RADIO_TIMEOUT_S: ("RC_FS_TIMEOUT", 1.0),
+    Key.FS_THR_VALUE: ("FS_THR_VALUE", 1.0),
+    Key.RTL_ALT_CM: ("RTL_ALT", 1.0),
+    Key.RTL_LOIT_TIME_MS: ("RTL_LOIT_TIME", 1.0),
+    Key.WP_RADIUS_CM: ("WPNAV_RADIUS", 1.0),
+    Key.WP_SPEED_CMS: ("WPNAV_SPEED", 1.0),
+    Key.WP_SPEED_UP_CMS: ("WPNAV_SPEED_UP", 1.0),
+    Key.WP_SPEED_DN_CMS: ("WPNAV_SPEED_DN", 1.0),
     **{getattr(Key, f"RC{n}_DZ"): (f"RC{n}_DZ", 1.0) for n in (1, 2, 3, 4)},
 }
 
@@ -197,6 +221,8 @@ FIXED_VALUES: dict[Profile, dict[Key, float]] = {
         Key.DISARM_DELAY_S: 15.0,
         Key.RC_OVERRIDE_TIME: 0.0,
         Key.SPOOL_TIME_S: 0.0,
+        Key.FS_OPTIONS: 0.0,
+        Key.RADIO_TIMEOUT_S: 2.0,  # FAILSAFE_RADIO_TIMEOUT_MS
     },
     # 4.x estimates height with its EKF; this SITL keeps the 3.2.1 filter and surface tracking
     # gain on copter4 too.

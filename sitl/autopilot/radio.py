@@ -1,10 +1,16 @@
-"""Radio input with GCS overrides, per each firmware's RC_CHANNELS_OVERRIDE rules."""
+"""Radio input with GCS overrides, per each firmware's RC_CHANNELS_OVERRIDE rules.
+
+With a receiver (`RcInput.MIN` / `MID`) a channel no override holds reads the receiver: sticks
+centred, switches low, the throttle at 1000 or 1500 µs. Without one (`ABSENT`) nothing updates a
+channel once its override ends, so it keeps the last value flown (both firmwares keep
+`radio_in` when no new frame arrives; 4.x `RC_Channel::update` returns without touching it).
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
-from sitl.autopilot.profile import Profile
+from sitl.autopilot.profile import Profile, RcInput
 
 UINT16_MAX = 65535
 N_CHANNELS = 8
@@ -17,9 +23,12 @@ RADIO_IDLE_US: tuple[int, ...] = (1500, 1500, 1000, 1500, 1000, 1000, 1000, 1000
 class Radio:
     """Channel values the autopilot sees: the radio's, unless a GCS override holds a channel."""
 
-    def __init__(self, profile: Profile) -> None:
+    def __init__(self, profile: Profile, rc_input: RcInput = RcInput.MIN) -> None:
         self.profile = profile
+        self.rc_input = rc_input
         self.radio_us = list(RADIO_IDLE_US)
+        if rc_input is RcInput.MID:
+            self.radio_us[2] = 1500
         self._override: list[int] = [0] * N_CHANNELS
         self._override_t_s: list[float] = [0.0] * N_CHANNELS
 
@@ -33,6 +42,8 @@ class Radio:
                 continue
             self._override[i] = min(RADIO_MAX_US, max(RADIO_MIN_US, int(v)))
             self._override_t_s[i] = t_s
+            if self.rc_input is RcInput.ABSENT:
+                self.radio_us[i] = self._override[i]  # what the channel keeps once it ends
 
     def clear_overrides(self) -> None:
         """Drop every override (GCS failsafe)."""

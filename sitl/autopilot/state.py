@@ -50,4 +50,3 @@ class AutopilotState:
     gcs_failsafe: bool = False
     radio_failsafe: bool = False
     battery_failsafe: bool = False
-    hold_for_gcs: bool = False

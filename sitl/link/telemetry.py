@@ -27,6 +27,8 @@ MAV_AUTOPILOT_ARDUPILOTMEGA = 3
 BASE_MODE_DISARMED = 81  # CUSTOM_MODE_ENABLED | STABILIZE_ENABLED | MANUAL_INPUT_ENABLED
 BASE_MODE_ARMED = 209  # + SAFETY_ARMED
 BASE_MODE_BOOT = 89  # what ArduCopter reports while it initialises (measured on 4.7)
+MAV_MODE_FLAG_GUIDED_ENABLED = 8  # RTL and SmartRTL in both firmwares (3.2.1 RTL armed: 217)
+GUIDED_MODES = frozenset({FlightMode.RTL, FlightMode.SMART_RTL})
 MAV_DISTANCE_SENSOR_ULTRASOUND = 1
 MAV_SENSOR_ROTATION_PITCH_270 = 25  # facing down
 
@@ -63,6 +65,8 @@ def heartbeat(v: VehicleView) -> Any:
         base_mode = BASE_MODE_BOOT
     else:
         base_mode = BASE_MODE_DISARMED
+    if st.mode in GUIDED_MODES:
+        base_mode |= MAV_MODE_FLAG_GUIDED_ENABLED
     return messages.MAVLink_heartbeat_message(
         MAV_TYPE_QUADROTOR,
         MAV_AUTOPILOT_ARDUPILOTMEGA,

@@ -47,7 +47,9 @@ def _alt(msg: object) -> float:
 
 @pytest.fixture
 def apm25(tmp_path: Path, world_file: Path) -> Iterator[tuple[SitlProcess, Station]]:
-    sitl = _start(tmp_path, world_file, "apm25")
+    # no receiver and no GPS: the radio failsafe's LAND (with the default receiver and GPS a
+    # silent GCS gets 3.2.1's RTL, tests/sitl/test_failsafe_conformance.py)
+    sitl = _start(tmp_path, world_file, "apm25", "--rc-input", "absent", "--no-gps")
     station = Station(f"tcp:{sitl.endpoint(1, 'tcp')}", mavlink1=True)
     yield sitl, station
     station.close()

@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from sitl.autopilot import AutopilotOptions, FlightMode, Profile
+from sitl.autopilot.profile import RcInput
 from sitl.link import telemetry as tm
 from sitl.simulation import Simulation
 from sitl.world import WorldError, load_world
@@ -193,7 +194,11 @@ def test_copter4_motors_stopped_2_s_after_arming_then_spool_over_mot_spool_time(
 
 
 # ---- 4. 4.x GCS failsafe defaults ------------------------------------------------------------
-def test_copter4_gcs_failsafe_off_by_default_then_fs_gcs_timeout_and_value_5_lands() -> None:
+def test_copter4_gcs_failsafe_off_by_default_then_value_5_continues_pilot_control() -> None:
+    """FS_GCS_ENABLE 0 by default; set to 5 (LAND) with FS_GCS_TIMEOUT 2, the 4.x default
+    FS_OPTIONS 16 ("continue in pilot-controlled modes") still keeps STABILIZE, and the failsafe
+    clears the overrides: the throttle is the receiver's 1000 µs and the vehicle falls, as the
+    real 4.7 did (fixtures' uplink-fade)."""
     _sim, gcs = make(Profile.COPTER4)
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.2)
@@ -213,10 +218,32 @@ def test_copter4_gcs_failsafe_off_by_default_then_fs_gcs_timeout_and_value_5_lan
     msgs = pilot.fly(1.9)
     assert not [t for t in _texts(gcs, msgs) if "Failsafe" in t]
     msgs = pilot.fly(0.3)
+    assert "GCS Failsafe - Continuing Pilot Control" in _texts(gcs, msgs)
+    msgs = pilot.fly(0.3)
+    assert gcs.of_type("SIM_STATE", msgs)[-1].vd > 0.5  # falling on the receiver's throttle
+    pilot.fly(0.7)
+    assert _hb(gcs)[:2] == (0, 209)  # still STABILIZE, armed
+
+
+def test_copter4_gcs_failsafe_5_lands_with_fs_options_0() -> None:
+    """What a station's --fix-failsafe sets on 4.x (FS_OPTIONS bit 4 off, FS_GCS_ENABLE 5,
+    FS_GCS_TIMEOUT 2 under RC_OVERRIDE_TIME): the GCS failsafe's LAND."""
+    _sim, gcs = make(Profile.COPTER4, seed=4)
+    _set(gcs, "FS_GCS_ENABLE", 5.0)  # 5 = LAND on 4.x
+    _set(gcs, "FS_GCS_TIMEOUT", 2.0)
+    _set(gcs, "FS_OPTIONS", 0.0)
+    pilot = Pilot(gcs)
+    take_off(gcs, pilot, 1.2)
+    pilot.sticks[2] = HOVER_STICK_US
+    pilot.fly(1.0)
+    pilot.overrides = pilot.heartbeats = False
+    msgs = pilot.fly(1.9)
+    assert not [t for t in _texts(gcs, msgs) if "Failsafe" in t]
+    msgs = pilot.fly(0.3)
     assert "GCS Failsafe" in _texts(gcs, msgs)
     pilot.fly(1.0)
     assert _hb(gcs) == (9, 209, 5)  # LAND, still armed, CRITICAL
-    assert truth_alt(gcs) > 0.4  # landing, not falling: the overrides had not lapsed yet
+    assert truth_alt(gcs) > 0.4  # landing, not falling
 
 
 def test_fs_gcs_timeout_is_clamped_to_its_range_and_3_2_1_keeps_5_s() -> None:
@@ -248,8 +275,13 @@ def test_disarm_delay_auto_disarms_on_the_floor() -> None:
 
 
 # ---- 5. when the overrides stop --------------------------------------------------------------
+NO_RECEIVER_NO_GPS = AutopilotOptions(rc_input=RcInput.ABSENT, gps=False)
+
+
 def test_apm25_radio_failsafe_lands_2_s_after_the_last_override_overrides_stay() -> None:
-    _sim, gcs = make(Profile.APM25)
+    """No receiver and no GPS: 2 s after the last override the radio failsafe lands (with a GPS
+    it would pick RTL; tests/sitl/test_failsafe_conformance.py)."""
+    _sim, gcs = make(Profile.APM25, options=NO_RECEIVER_NO_GPS)
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.2)
     pilot.sticks[2] = HOVER_STICK_US
@@ -277,8 +309,8 @@ def test_apm25_radio_failsafe_lands_2_s_after_the_last_override_overrides_stay()
 def test_apm25_radio_failsafe_land_levels_whatever_the_last_override_leant() -> None:
     """land_nogps_run takes no pilot roll, pitch or yaw under a radio failsafe: the dead
     uplink's last override, still on the radio, must not keep the vehicle leaning (it once
-    carried a landing vehicle into a wall and down a 0.45 m drop)."""
-    _sim, gcs = make(Profile.APM25)
+    carried a landing vehicle into a wall and down a 0.45 m drop). No receiver, no GPS."""
+    _sim, gcs = make(Profile.APM25, options=NO_RECEIVER_NO_GPS)
     pilot = Pilot(gcs)
     take_off(gcs, pilot, 1.2)
     pilot.sticks[2] = HOVER_STICK_US
