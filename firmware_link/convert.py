@@ -9,6 +9,7 @@ Scalings, as ArduPilot fills the messages:
   Only the primary IMU (RAW_IMU) is mapped, so a consumer never mixes two IMUs' streams.
 - RANGEFINDER.distance is metres; DISTANCE_SENSOR distances are centimetres.
 - SCALED_PRESSURE: hPa and centi-°C. SYS_STATUS: mV, cA (-1 unknown), % (-1 unknown).
+- GPS_RAW_INT: only the fix type and satellites (the pre-flight's "can RTL navigate").
 - SIMSTATE has attitude and lat/lng but no altitude or velocity: its `pos_n` z and `vel_n` are
   NaN. SIM_STATE carries all of them. Positions are metres north/east/down of the first truth
   fix seen for that vehicle (flat earth, fine over a room).
@@ -26,6 +27,7 @@ from firmware_link.records import (
     Barometer,
     Battery,
     CommandAck,
+    GpsFix,
     Heartbeat,
     Imu,
     MocapPose,
@@ -202,6 +204,10 @@ class RecordConverter:
             remaining_pct=int(msg.battery_remaining),
         )
 
+    def _gps_raw_int(self, msg: Any, t_s: float) -> GpsFix:
+        return GpsFix(t_s=t_s, sysid=msg.get_srcSystem(), fix_type=int(msg.fix_type),
+                      satellites=int(msg.satellites_visible))
+
     def _rc_channels(self, msg: Any, t_s: float) -> RcChannels:
         channels = tuple(int(getattr(msg, f"chan{i}_raw")) for i in range(1, 9))
         return RcChannels(t_s=t_s, sysid=msg.get_srcSystem(), channels_us=channels)
@@ -297,6 +303,7 @@ _HANDLERS = {
     "SCALED_PRESSURE": RecordConverter._scaled_pressure,
     "VFR_HUD": RecordConverter._vfr_hud,
     "SYS_STATUS": RecordConverter._sys_status,
+    "GPS_RAW_INT": RecordConverter._gps_raw_int,
     "RC_CHANNELS": RecordConverter._rc_channels,
     "RC_CHANNELS_RAW": RecordConverter._rc_channels,
     "SERVO_OUTPUT_RAW": RecordConverter._servo_output,

@@ -181,6 +181,16 @@ class Battery:
 
 
 @dataclass(frozen=True, slots=True)
+class GpsFix:
+    """GPS_RAW_INT's fix: what lets the autopilot's RTL navigate (3 and above: a 3D fix)."""
+
+    t_s: float
+    sysid: int
+    fix_type: int  # GPS_FIX_TYPE: 0 no GPS, 1 no fix, 2 2D, 3 3D, 4+ DGPS/RTK
+    satellites: int  # 255 when unknown
+
+
+@dataclass(frozen=True, slots=True)
 class RcChannels:
     """RC inputs as the autopilot sees them (after overrides), microseconds, channels 1..8."""
 
@@ -288,6 +298,7 @@ TelemetryRecord = (
     | Barometer
     | VfrHud
     | Battery
+    | GpsFix
     | RcChannels
     | ServoOutput
     | StatusText

@@ -200,6 +200,9 @@ def wanted_streams(dialect: Dialect, target_rate_hz: float = 40.0) -> tuple[Stre
         StreamWanted("RC_CHANNELS", 5.0, 1.0, ds.RC_CHANNELS),
         StreamWanted("SERVO_OUTPUT_RAW", 5.0, 1.0, ds.RC_CHANNELS),
         StreamWanted("SIM_STATE", 10.0, 1.0, ds.EXTRA1),
+        # the pre-flight judges the failsafe by the GPS fix (RTL navigates with one); 3.2.1
+        # sends it with SYS_STATUS's group, 4.x only when asked
+        StreamWanted("GPS_RAW_INT", 2.0, 0.5, ds.EXTENDED_STATUS),
     )
 
 

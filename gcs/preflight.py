@@ -1,11 +1,12 @@
 """Pre-flight checks: the vehicle's parameters must make the station's link-loss policy safe.
 
-The station lands a vehicle it cannot hear and then falls silent, so the autopilot's own GCS
-failsafe must be on, and on ArduCopter 4.x it must act before the RC overrides lapse
-(`RC_OVERRIDE_TIME`), or the throttle falls to the radio's minimum. The station also assumes the
-throttle on channel 3 spanning 1000..2000 µs, sticks on channels 1–4, and a battery above its
-failsafe. `evaluate` is pure; `read_and_check` reads the parameters over the link and, with the
-pilot's consent, sets the failsafe parameters (read back by the link).
+The station lands a vehicle it cannot hear and then falls silent, so what the autopilot's own
+failsafes do on a silent link must be a landing (or a hold, then a landing) without a climb, in
+the modes the station flies: `gcs.failsafe_policy` predicts it from the parameters and the GPS
+fix. The station also assumes the throttle on channel 3 spanning 1000..2000 µs, sticks on
+channels 1–4, and a battery above its failsafe. `evaluate` is pure; `read_and_check` reads the
+parameters over the link and, with the pilot's consent, sets what the failsafe needs, reads
+every value back and judges again.
 """
 
 from __future__ import annotations
@@ -15,12 +16,12 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from firmware_link.records import Dialect
+from gcs import failsafe_policy
+from gcs.failsafe_policy import FLOWN_MODES, VehicleState
 
 RC_SPAN_TOLERANCE_US = 50
 BATTERY_MARGIN_V = 0.2
-# 4.x FS_GCS_ENABLE 5 = LAND; 3.2.1 has no LAND option, 1 = RTL, which lands without GPS
-GCS_FAILSAFE_ON = {Dialect.APM25: 1.0, Dialect.COPTER4: 5.0}
-FS_GCS_TIMEOUT_MIN_S = 2.0  # the firmware's lower bound
+FAILSAFE = "failsafe"  # the check whose detail is the failsafe prediction's own line
 CHANNEL_MAP = {"RCMAP_ROLL": 1.0, "RCMAP_PITCH": 2.0, "RCMAP_THROTTLE": 3.0, "RCMAP_YAW": 4.0}
 
 
@@ -40,6 +41,9 @@ class PreflightReport:
 
     dialect: Dialect
     checks: tuple[Check, ...]
+    # what --fix-failsafe changed: (name, before, after as read back)
+    fixed: tuple[tuple[str, float, float], ...] = ()
+    fix_failed: tuple[str, ...] = ()  # what --fix-failsafe could not set, and why
 
     @property
     def ok(self) -> bool:
@@ -60,33 +64,41 @@ class PreflightReport:
         bad = [c for c in self.checks if not c.ok]
         if not bad:
             return "; ".join(c.detail for c in self.checks)
-        return "; ".join(f"{c.name}: {c.detail}" for c in bad)
+        return "; ".join([f"{c.name}: {c.detail}" if c.name != FAILSAFE else c.detail
+                          for c in bad] + [f"--fix-failsafe: {f}" for f in self.fix_failed])
+
+    def fix_line(self) -> str | None:
+        """One line saying what `--fix-failsafe` set and what the vehicle will now do (None
+        when it set nothing)."""
+        if not self.fixed and not self.fix_failed:
+            return None
+        done = [f"set {', '.join(f'{n} {a:g} -> {b:g}' for n, a, b in self.fixed)} (read back)"]
+        done = (done if self.fixed else []) + list(self.fix_failed)
+        after = next((c.detail for c in self.checks if c.name == FAILSAFE), "")
+        return f"--fix-failsafe: {'; '.join(done)}; {after}"
 
 
 def required_parameters(dialect: Dialect) -> tuple[str, ...]:
     """What `evaluate` reads for this firmware."""
-    names = ["FS_GCS_ENABLE", "RC3_MIN", "RC3_MAX", "RC3_TRIM", *CHANNEL_MAP]
-    if dialect is Dialect.COPTER4:
-        names += ["FS_GCS_TIMEOUT", "RC_OVERRIDE_TIME", "BATT_LOW_VOLT"]
-    else:
-        names += ["FS_BATT_VOLTAGE"]
+    names = [*failsafe_policy.required_parameters(dialect), "RC3_MIN", "RC3_MAX", "RC3_TRIM",
+             *CHANNEL_MAP]
+    names.append("BATT_LOW_VOLT" if dialect is Dialect.COPTER4 else "FS_BATT_VOLTAGE")
     return tuple(names)
 
 
 def evaluate(dialect: Dialect, params: Mapping[str, float], battery_v: float | None,
-             unreadable: Mapping[str, str] | None = None) -> PreflightReport:
-    """Judge the parameters (`unreadable`: name → why it could not be read)."""
+             unreadable: Mapping[str, str] | None = None,
+             state: VehicleState | None = None) -> PreflightReport:
+    """Judge the parameters (`unreadable`: name → why it could not be read; `state`: what the
+    vehicle reported, None: nothing, taken at its worst)."""
     missing = dict(unreadable or {})
 
     def get(name: str) -> float | None:
         return params.get(name) if name not in missing else None
 
-    checks = [_gcs_failsafe(dialect, get, missing)]
-    if dialect is Dialect.COPTER4:
-        checks.append(_override_lapse(get, missing))
-    checks.append(_throttle_range(get, missing))
-    checks.append(_channel_map(get, missing))
-    checks.append(_battery(dialect, get, battery_v))
+    checks = [_failsafe(dialect, params, missing, state or VehicleState()),
+              _throttle_range(get, missing), _channel_map(get, missing),
+              _battery(dialect, get, battery_v)]
     return PreflightReport(dialect, tuple(checks))
 
 
@@ -94,38 +106,22 @@ def _unreadable(name: str, missing: Mapping[str, str]) -> str:
     return f"could not read {name} ({missing.get(name, 'not reported')})"
 
 
-def _gcs_failsafe(dialect: Dialect, get: Callable[[str], float | None],
-                  missing: Mapping[str, str]) -> Check:
-    v = get("FS_GCS_ENABLE")
-    if v is None:
-        return Check("GCS failsafe", False, _unreadable("FS_GCS_ENABLE", missing))
-    on = GCS_FAILSAFE_ON.get(dialect, 1.0)
-    if v == 0:
-        return Check("GCS failsafe", False, "FS_GCS_ENABLE is 0: a lost link would leave the "
-                     f"vehicle with no failsafe (set FS_GCS_ENABLE {on:g})", {"FS_GCS_ENABLE": on})
-    return Check("GCS failsafe", True, f"FS_GCS_ENABLE {v:g}")
-
-
-def _override_lapse(get: Callable[[str], float | None], missing: Mapping[str, str]) -> Check:
-    timeout, lapse = get("FS_GCS_TIMEOUT"), get("RC_OVERRIDE_TIME")
-    for name, v in (("FS_GCS_TIMEOUT", timeout), ("RC_OVERRIDE_TIME", lapse)):
-        if v is None:
-            return Check("failsafe before overrides lapse", False, _unreadable(name, missing))
-    assert timeout is not None and lapse is not None
-    if lapse == 0:
-        return Check("failsafe before overrides lapse", False,
-                     "RC_OVERRIDE_TIME is 0: the vehicle ignores RC overrides")
-    if lapse < 0:  # overrides never lapse: the GCS failsafe alone decides
-        return Check("failsafe before overrides lapse", True, "RC_OVERRIDE_TIME never lapses")
-    if timeout < lapse:
-        return Check("failsafe before overrides lapse", True,
-                     f"FS_GCS_TIMEOUT {timeout:g} s < RC_OVERRIDE_TIME {lapse:g} s")
-    want = max(FS_GCS_TIMEOUT_MIN_S, math.floor(lapse) - 1.0)
-    fix = {"FS_GCS_TIMEOUT": want} if want < lapse else {}
-    return Check("failsafe before overrides lapse", False,
-                 f"FS_GCS_TIMEOUT {timeout:g} s is not shorter than RC_OVERRIDE_TIME {lapse:g} s: "
-                 "the throttle would fall to the radio's minimum before the failsafe lands the "
-                 f"vehicle" + (f" (set FS_GCS_TIMEOUT {want:g})" if fix else ""), fix)
+def _failsafe(dialect: Dialect, params: Mapping[str, float], missing: Mapping[str, str],
+              state: VehicleState) -> Check:
+    """What the vehicle does on a silent link in every mode the station flies: the first
+    unsafe prediction names the parameter and the fix."""
+    for name in failsafe_policy.required_parameters(dialect):
+        if name in missing or name not in params:
+            return Check(FAILSAFE, False, f"{FAILSAFE}: {_unreadable(name, missing)}")
+    fix = failsafe_policy.safe_settings(dialect, params, state)
+    first = None
+    for mode in FLOWN_MODES:
+        p = failsafe_policy.predict(dialect, params, state, mode)
+        if not p.safe:
+            return Check(FAILSAFE, False, p.line(), fix)
+        first = first or p
+    assert first is not None
+    return Check(FAILSAFE, True, first.line())
 
 
 def _throttle_range(get: Callable[[str], float | None], missing: Mapping[str, str]) -> Check:
@@ -169,9 +165,35 @@ def _battery(dialect: Dialect, get: Callable[[str], float | None],
 
 
 def read_and_check(get_param: Callable[[str], float], set_param: Callable[[str, float], float],
-                   dialect: Dialect, battery_v: float | None, *, fix: bool) -> PreflightReport:
+                   dialect: Dialect, battery_v: float | None, *, fix: bool,
+                   state: VehicleState | None = None) -> PreflightReport:
     """Read what `evaluate` needs; with `fix` (the pilot's consent), set the failsafe parameters
-    that would make it pass and judge again. `get_param`/`set_param` raise on failure."""
+    that would make it pass, read every parameter back and judge again. `get_param` /
+    `set_param` raise on failure (`set_param` returns the value the vehicle stored)."""
+    params, unreadable = _read_all(get_param, dialect)
+    report = evaluate(dialect, params, battery_v, unreadable, state)
+    if not (fix and report.fixes):
+        return report
+    before = dict(params)
+    failed: list[str] = []
+    for name, value in report.fixes.items():
+        try:
+            set_param(name, value)
+        except Exception as exc:  # reported by name; the read-back below judges what stuck
+            failed.append(f"{name} not set to {value:g} ({exc})")
+    params, unreadable = _read_all(get_param, dialect)
+    report = evaluate(dialect, params, battery_v, unreadable, state)
+    fixed = tuple((n, before[n], params[n]) for n in _changed(before, params))
+    return PreflightReport(report.dialect, report.checks, fixed, tuple(failed))
+
+
+def _changed(before: Mapping[str, float], after: Mapping[str, float]) -> list[str]:
+    """The parameters whose value changed, in reading order."""
+    return [n for n in after if n in before and after[n] != before[n]]
+
+
+def _read_all(get_param: Callable[[str], float],
+              dialect: Dialect) -> tuple[dict[str, float], dict[str, str]]:
     params: dict[str, float] = {}
     unreadable: dict[str, str] = {}
     for name in required_parameters(dialect):
@@ -179,12 +201,4 @@ def read_and_check(get_param: Callable[[str], float], set_param: Callable[[str, 
             params[name] = float(get_param(name))
         except Exception as exc:  # every failure is reported by name, never a silent default
             unreadable[name] = str(exc) or type(exc).__name__
-    report = evaluate(dialect, params, battery_v, unreadable)
-    if fix and report.fixes:
-        for name, value in report.fixes.items():
-            try:
-                params[name] = float(set_param(name, value))
-            except Exception as exc:
-                unreadable[name] = f"set to {value:g} failed: {exc}"
-        report = evaluate(dialect, params, battery_v, unreadable)
-    return report
+    return params, unreadable

@@ -99,7 +99,7 @@ class BaseFlight:
     world: str | None = None  # paths as the file writes them, relative to `root`
     config: str | None = None
     record: bool = False
-    fix_failsafe: bool = False  # fly's --fix-failsafe: copter4 ships FS_GCS_ENABLE = 0
+    fix_failsafe: bool = False  # fly's --fix-failsafe: copter4 ships FS_GCS_ENABLE 0, FS_OPTIONS 16
     root: Path = Path(".")  # the campaign file's directory
 
     def resolve(self, text: str | None) -> Path | None:

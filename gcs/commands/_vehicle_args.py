@@ -27,9 +27,11 @@ def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("-o", "--output", type=Path, default=Path("flights"),
                    help="recording file or directory (default flights/)")
     p.add_argument("--fix-failsafe", action="store_true",
-                   help="let the station set the vehicle's GCS failsafe parameters when the "
-                        "pre-flight checks find them unsafe (FS_GCS_ENABLE, FS_GCS_TIMEOUT); "
-                        "without it such a vehicle is refused")
+                   help="let the station set the vehicle's failsafe parameters when the "
+                        "pre-flight checks find that a silent link would not land it (4.x: "
+                        "FS_OPTIONS bit 4 off, FS_GCS_ENABLE 5, FS_GCS_TIMEOUT under "
+                        "RC_OVERRIDE_TIME; 3.2.1 with GPS: RTL_ALT 0); without it such a "
+                        "vehicle is refused")
     add_forward_argument(p)
     add_foxglove_argument(p)
 

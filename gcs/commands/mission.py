@@ -46,8 +46,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--plot", type=Path, help="radiation: picture path (default: next to the "
                                              "recording)")
     r.add_argument("--fix-failsafe", action="store_true",
-                   help="let the station set the vehicles' GCS failsafe parameters when the "
-                        "pre-flight checks find them unsafe; without it such a vehicle is refused")
+                   help="let the station set the vehicles' failsafe parameters when the "
+                        "pre-flight checks find that a silent link would not land them (see "
+                        "fly --help); without it such a vehicle is refused")
     r.add_argument("--no-truth", dest="truth", action="store_false",
                    help="keep the world's sources and boxes from the station and the planner "
                         "(the SITL or kinematic world still simulates them) and score nothing "

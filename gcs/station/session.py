@@ -25,13 +25,14 @@ from firmware_link import (
     VehicleLink,
     load_signing_key,
 )
-from firmware_link.records import Battery, Dialect, MocapPose
+from firmware_link.records import Battery, Dialect, GpsFix, MocapPose
 from firmware_link.truth_link import TruthLink, TruthRecorder
 from gcs.clock import Clock, MonotonicClock, ScaledClock
 from gcs.config import StationConfig, load_config
 from gcs.control.position_controller import STICK_PARAMS, with_vehicle_sticks
 from gcs.control.throttle_curve import ThrottleCurve
 from gcs.errors import UsageError
+from gcs.failsafe_policy import VehicleState
 from gcs.foxglove_feed import DEFAULT_WORLD, FoxgloveFeed, open_live, world_boxes
 from gcs.parallel_open import open_in_parallel
 from gcs.preflight import PreflightReport, read_and_check
@@ -153,18 +154,27 @@ class StationSession:
         self._stack.close()
 
     def _preflight(self, link: VehicleLink, wait_s: float = 2.0) -> PreflightReport:
-        """Read the failsafe, radio and battery facts and judge them (setting the failsafe
-        parameters with the pilot's consent)."""
+        """Read the failsafe, radio and battery facts and the GPS fix, and judge them (setting
+        the failsafe parameters with the pilot's consent). A GPS the vehicle did not report
+        within `wait_s` is judged at its worst (a fix: RTL navigates)."""
         battery_v: float | None = None
+        fix_type: int | None = None
         deadline = self.clock.now_s() + wait_s
-        while battery_v is None and self.clock.now_s() < deadline:
+        while (battery_v is None or fix_type is None) and self.clock.now_s() < deadline:
             for r in link.poll():
                 if isinstance(r, Battery) and r.voltage_v > 0.0:
                     battery_v = r.voltage_v
-            if battery_v is None:
+                elif isinstance(r, GpsFix):
+                    fix_type = r.fix_type
+            if battery_v is None or fix_type is None:
                 self.clock.sleep_until(self.clock.now_s() + 0.05)
-        return read_and_check(link.get_param, link.set_param, link.dialect, battery_v,
-                              fix=self.options.fix_failsafe)
+        report = read_and_check(link.get_param, link.set_param, link.dialect, battery_v,
+                                fix=self.options.fix_failsafe,
+                                state=VehicleState(gps_fix_type=fix_type))
+        line = report.fix_line()
+        if line is not None:
+            print(f"vehicle {link.target_system}: {line}", file=sys.stderr, flush=True)
+        return report
 
     @staticmethod
     def _vehicle_sticks(link: VehicleLink, config: Any) -> Any:

@@ -15,6 +15,7 @@ from firmware_link.records import (
     Barometer,
     Battery,
     CommandAck,
+    GpsFix,
     Heartbeat,
     Imu,
     ParamValue,
@@ -174,3 +175,11 @@ def test_simstate_then_sim_state_share_an_origin_without_a_false_altitude() -> N
     base = [1, 0, 0, 0, 0, 0, 0, 0, 0, -G, 0, 0, 0, 47.3, 8.5, 408.0, 0, 0, 0, 0, 0]
     (truth,) = conv.convert(_msg("sim_state_encode", *base, 473_000_000, 85_000_000), 0.1)
     assert truth.pos_n == (0.0, 0.0, 0.0)  # ground level, not -408 m
+
+
+def test_gps_raw_int_gives_the_real_simulators_fix(records_by_type: dict[type, list]) -> None:
+    # 4.7's SITL has a GPS with home set: the fix the pre-flight judges RTL by
+    fixes = records_by_type[GpsFix]
+    assert len(fixes) > 100
+    assert max(r.fix_type for r in fixes) >= 3
+    assert all(0 <= r.fix_type <= 8 and r.sysid == 1 for r in fixes)
