@@ -137,6 +137,16 @@ class AltitudeController:
         stick = self.curve.stick_us(self.hover_throttle)
         return round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
 
+    def trimmed_hover_stick_us(self) -> int:
+        """The stick PWM the hold actually hovers at, level: the learned hover with the trim its
+        integrator still holds (the learner hands that trim over with a 10 s time constant, so
+        a hold started from 3.2.1's THR_MID still carried 1439 us of "hover" against the
+        vehicle's real 1370 us, and a throttle held blind on it climbed)."""
+        p = self.params
+        motor = self.hover_throttle * (1.0 + self.pid.integrator / GRAVITY_MPS2)
+        stick = self.curve.stick_us(max(motor, 0.0))
+        return round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
+
     def update(self, setpoint_m: float, estimate: AltEstimate, roll_rad: float, pitch_rad: float,
                dt_s: float, *, on_floor: bool = False, rate_mps: float | None = None,
                sink_limit_mps2: float | None = None) -> AltControlOutput:
