@@ -237,7 +237,7 @@ class StateCommands:
         pilot's own stick in MANUAL."""
         if self.on_floor(alt_m):
             return STICK_MIN_US
-        hover = self.alt_ctrl.trimmed_hover_stick_us()
+        hover = self.alt_ctrl.flown_hover_stick_us()
         if self.state is S.MANUAL:
             return min(hover, self.sticks.throttle_us if self.gate_us is None else self.gate_us)
         return hover

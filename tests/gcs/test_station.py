@@ -174,7 +174,7 @@ def test_downlink_loss_lands_stays_and_does_not_resume() -> None:
     assert st.snapshot().state is SupervisorState.LINK_LOST
     assert FlightMode.LAND in board.modes
     held = board.overrides[-1]
-    assert held.throttle_us == st.core.alt_ctrl.trimmed_hover_stick_us()
+    assert held.throttle_us == st.core.alt_ctrl.flown_hover_stick_us()
     assert held.roll_us == 1500
     run_s(st, 3.5)
     assert st.snapshot().state is SupervisorState.LINK_LOST

@@ -165,9 +165,9 @@ def test_kill_on_apm25_in_land_switches_to_stabilize_so_disarm_is_accepted() -> 
 def test_short_gap_holds_hover_throttle_level_then_hold_resumes() -> None:
     s = Script()
     s.hovering()
-    s.run(1.0)
+    s.run(6.0)  # steady long enough for the flown hover (1 s time constant) to settle
     # the hover the hold flies at: learned, with its integrator's trim (#32)
-    hover = s.sup.alt_ctrl.trimmed_hover_stick_us()
+    hover = s.sup.alt_ctrl.flown_hover_stick_us()
     s.down = False
     outs = s.run(0.6)
     held = [o for o in outs if o.link is LinkHealth.DEGRADED]
@@ -202,7 +202,7 @@ def test_link_lost_in_manual_flight_never_raises_the_pilots_throttle() -> None:
     s.tick(Intent(IntentKind.STICKS, throttle_us=1350))  # descending, below hover
     s.alt = 1.2
     s.run(0.5)
-    hover = s.sup.alt_ctrl.trimmed_hover_stick_us()
+    hover = s.sup.alt_ctrl.flown_hover_stick_us()
     assert hover > 1350
     s.down = False
     outs = s.run(2.0)
@@ -216,8 +216,8 @@ def test_long_gap_lands_stays_until_disarmed_and_nothing_resumes() -> None:
     on, the throttle at minimum once a LAND from the height last seen has touched down."""
     s = Script()
     s.hovering()
-    s.run(1.0)
-    hover = s.sup.alt_ctrl.trimmed_hover_stick_us()
+    s.run(6.0)  # steady long enough for the flown hover (1 s time constant) to settle
+    hover = s.sup.alt_ctrl.flown_hover_stick_us()
     s.down = False
     outs = s.run(1.6)
     assert s.sup.state is S.LINK_LOST
