@@ -129,3 +129,26 @@ def test_link_lost_both_ways_then_back_disarmed_and_stays_on_the_floor(vehicle: 
         assert all(not armed for _, _, armed, _ in after)
         assert max(h for _, h, _, _ in after) < 0.1
         assert FlightMode.RTL not in {m for *_, m in after} or vehicle.endswith("rtl-alt-0")
+
+
+@pytest.mark.parametrize("vehicle", list(VEHICLES))
+def test_downlink_lost_for_good_the_station_lands_it_and_stays_until_it_disarms(
+        vehicle: str) -> None:
+    """The issue's row: the vehicle's frames stop for good, the station's still arrive. Its LAND
+    lands the vehicle; the station, blind, keeps heartbeats and, once that LAND has had time to
+    touch down, the throttle at minimum, so 3.2.1 disarms. Until #32 it went quiet 3 s after
+    the loss with its last override at hover: the landed vehicle stayed armed and its GCS
+    failsafe fired on it (RTL: on the real 3.2.1 back up to 13.9 m)."""
+    fade_at = 40.0
+    faults = {"fade": "down", "fade_start_s": fade_at, "fade_s": 1000.0}
+    with _flying(vehicle, faults) as (st, watch):
+        t0 = watch.rows[-1][0]
+        assert t0 < fade_at - 2.0, t0
+        _ticks(st, fade_at + 60.0 - t0)
+        rows = watch.after(fade_at)
+        off = [t for t, _, armed, _ in rows if not armed]
+        assert off and off[0] - fade_at <= 20.0, off[:1]
+        assert max(h for _, h, _, _ in rows) <= 1.0 + 0.3
+        assert max(h for t, h, _, _ in rows if t >= off[0]) < 0.1
+        assert {m for *_, m in rows} <= {int(FlightMode.STABILIZE), int(FlightMode.LAND)}
+        assert st.snapshot().state is SupervisorState.LINK_LOST  # still blind, still there
