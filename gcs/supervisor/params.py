@@ -45,7 +45,7 @@ class SupervisorParams:
     # ArduCopter 3.2.1 goes quiet for up to ~1 s while it arms (it recalibrates the barometer
     # in its main loop: the fixture tlog has gaps of 0.85 s and 1.01 s), so 1.5 s, not less
     lost_after_s: float = 1.5
-    land_request_s: float = 3.0  # LAND commanded this long before going silent
+    land_request_s: float = 3.0  # LAND asked with the hover this long, then its descent counts
     mode_resend_s: float = 0.5
     disarm_resend_s: float = 0.2  # kill: ≥ 5 Hz
     arm_resend_s: float = 1.0
