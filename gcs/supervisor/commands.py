@@ -73,6 +73,7 @@ class StateCommands:
         self._lost_height_m = 0.0  # above the rest height when the link was lost
         self._lost_down = False  # a LAND asked on the lost link has had time to touch down
         self._takeoff_asked_s = -math.inf  # a take-off asked while arming, waiting for the arm
+        self.arm_wait_s = params.arm_timeout_s  # how long the arm asked now is asked again
         self._in_land_s: float | None = None  # quitting: when a heartbeat first showed LAND
         self._disarm_report_s = math.inf  # quitting: when the next "still armed" is due
         self._next_send_s = -math.inf
@@ -165,10 +166,10 @@ class StateCommands:
                 self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING,
                             f"take-off expired: the vehicle did not arm within "
                             f"{self.p.takeoff_wait_s:g} s of it; ask again once armed")
-            if self._t - self.since_s > self.p.arm_timeout_s:
+            if self._t - self.since_s > self.arm_wait_s:
                 self._takeoff_wanted = False
-                self._go(S.DISARMED, f"vehicle did not arm within {self.p.arm_timeout_s:g} s",
-                         Level.ERROR)
+                self._go(S.DISARMED, f"vehicle did not arm within {self.arm_wait_s:g} s: the arm "
+                         "request has expired, ask again", Level.ERROR)
                 self._went(OutcomeKind.ARM_TIMED_OUT)
             else:
                 self._send_every(self.p.arm_resend_s, Action(ActionKind.ARM))

@@ -49,7 +49,10 @@ class SupervisorParams:
     mode_resend_s: float = 0.5
     disarm_resend_s: float = 0.2  # kill: ≥ 5 Hz
     arm_resend_s: float = 1.0
-    arm_timeout_s: float = 30.0
+    # A pilot's arm is asked again each arm_resend_s for this long, then expires and says so: on
+    # the real 4.7 (pre-arm refused ~24 s after boot) an arm kept asked for 30 s armed the vehicle
+    # by itself 20 s after the key. A launch that means to wait asks for longer (Intent.wait_s).
+    arm_timeout_s: float = 5.0
     # A take-off asked while arming waits this long for the arm, then expires and says so: on
     # the real 4.7 a take-off key pressed while pre-arm refused stayed queued and the vehicle
     # took off by itself when it armed 20 s later.

@@ -89,7 +89,7 @@ class Supervisor(StateCommands):
         elif self.state in (S.LINK_LOST, S.SILENT, S.QUITTING):
             self._ignored(k, f"{k.value} ignored while {self.state.value}")
         elif k is IntentKind.ARM:
-            self._arm()
+            self._arm(it.wait_s)
         elif k is IntentKind.DISARM:
             self._actions.append(Action(ActionKind.DISARM))
             self._note(Level.INFO, "disarm requested")
@@ -119,7 +119,8 @@ class Supervisor(StateCommands):
         else:
             self._note(Level.WARNING, text)
 
-    def _arm(self) -> None:
+    def _arm(self, wait_s: float | None) -> None:
+        self.arm_wait_s = self.p.arm_timeout_s if wait_s is None else wait_s
         if self.state is not S.DISARMED:
             self._ended(OutcomeKind.ARM_IGNORED, Level.WARNING,
                         f"arm ignored: already {self.state.value}")

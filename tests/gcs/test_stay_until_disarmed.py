@@ -102,3 +102,22 @@ def test_a_takeoff_asked_while_arming_flies_when_it_arms_in_time(arm_after_s: fl
     s.heartbeat_now()
     s.tick()
     assert s.sup.state is S.SPOOL_UP
+
+
+def test_a_pilots_arm_expires_in_seconds_and_says_so_a_launchs_waits() -> None:
+    """4.x's pre-arm refuses for ~24 s after boot: the pilot's arm is asked for 5 s, then ends
+    (said); nothing asks it again, so the vehicle does not arm 20 s later by itself. A launch
+    (fly, teams) that means to wait out the pre-arm asks with its own wait."""
+    s = Script()
+    s.tick(Intent(IntentKind.PREFLIGHT, ok=True, note="test"))
+    outs = [s.tick(Intent(IntentKind.ARM)), *s.run(25.0)]
+    asked = [i for i, o in enumerate(outs) if any(a.kind is ActionKind.ARM for a in o.actions)]
+    assert asked and (asked[-1] - asked[0]) * 0.025 <= 5.0
+    ended = [oc for o in outs for oc in o.outcomes]
+    assert [oc.kind for oc in ended] == [OutcomeKind.ARM_TIMED_OUT]
+    assert "expired" in ended[0].note and s.sup.state is S.DISARMED
+    s2 = Script()
+    s2.tick(Intent(IntentKind.PREFLIGHT, ok=True, note="test"))
+    outs = [s2.tick(Intent(IntentKind.ARM, wait_s=30.0)), *s2.run(25.0)]
+    assert s2.sup.state is S.ARMING
+    assert sum(any(a.kind is ActionKind.ARM for a in o.actions) for o in outs) >= 24
