@@ -61,10 +61,10 @@ def test_the_gap_throttle_is_the_hover_the_hold_flies_at_not_the_assumed_one() -
     accel = ctrl.accel_for_throttle(true_hover, 0.0, 0.0)
     ctrl.pid.engage(1.0, 1.0, accel)  # the trim a steady hold at the true hover ends with
     assert abs(ctrl.flown_hover_stick_us() - true_hover) > 60  # not yet flown steady
-    outs = s.run(5.0)  # steady: the hold flies (about) the true hover
+    outs = s.run(12.0)  # steady: the hold flies (about) the true hover
     flown = outs[-1].command.throttle_us if outs[-1].command is not None else 0
     assert abs(flown - true_hover) <= 15  # (its downward command is clipped to the envelope)
-    assert abs(ctrl.hover_stick_us() - flown) > 60  # the 10 s learner is still far
+    assert abs(ctrl.hover_stick_us() - flown) > 25  # the 10 s learner is still far
     assert abs(ctrl.flown_hover_stick_us() - flown) <= 3
     s.down = False
     outs = s.run(2.0)

@@ -165,7 +165,7 @@ def test_kill_on_apm25_in_land_switches_to_stabilize_so_disarm_is_accepted() -> 
 def test_short_gap_holds_hover_throttle_level_then_hold_resumes() -> None:
     s = Script()
     s.hovering()
-    s.run(6.0)  # steady long enough for the flown hover (1 s time constant) to settle
+    s.run(12.0)  # steady long enough for the flown hover (2 s time constant) to settle
     # the hover the hold flies at: learned, with its integrator's trim (#32)
     hover = s.sup.alt_ctrl.flown_hover_stick_us()
     s.down = False
@@ -216,7 +216,7 @@ def test_long_gap_lands_stays_until_disarmed_and_nothing_resumes() -> None:
     on, the throttle at minimum once a LAND from the height last seen has touched down."""
     s = Script()
     s.hovering()
-    s.run(6.0)  # steady long enough for the flown hover (1 s time constant) to settle
+    s.run(12.0)  # steady long enough for the flown hover (2 s time constant) to settle
     hover = s.sup.alt_ctrl.flown_hover_stick_us()
     s.down = False
     outs = s.run(1.6)
