@@ -32,6 +32,7 @@ STICK_MID_US, STICK_MIN_US = 1500, 1000
 MODE_TIMEOUT_S = 10.0
 REST_S = 3.0  # disarmed on the floor first: the estimators learn the accelerometer bias at rest
 ARM_TIMEOUT_S = 40.0  # from the request; the supervisor gives up re-asking before (30 s)
+ARM_ASKED_S = 30.0  # a launch's arm is asked this long (4.x's pre-arm refuses ~24 s after boot)
 # Take-off must be asked this long before the first-armed vehicle's auto-disarm: the request
 # reaches the vehicle on the next tick, and the throttle has to leave minimum there.
 AUTO_DISARM_MARGIN_S = 5.0
@@ -75,7 +76,7 @@ class LaunchStation(Protocol):
     def supervisor_params(self) -> SupervisorParams: ...
     def set_sticks(self, roll_us: int, pitch_us: int, yaw_us: int, throttle_us: int) -> None: ...
     def set_mode(self, mode: FlightMode) -> None: ...
-    def request_arm(self) -> None: ...
+    def request_arm(self, wait_s: float | None = None) -> None: ...
     def request_disarm(self) -> None: ...
     def alt_hold(self, on: bool, setpoint_m: float | None = None,
                  rate_mps: float | None = None) -> None: ...
@@ -169,7 +170,7 @@ class Launch:
         asked_at = port.now_s()
         port.told(LaunchStage.ARMING, f"{len(self.stations)} vehicle(s) together")
         for st in self.stations.values():
-            st.request_arm()
+            st.request_arm(wait_s=ARM_ASKED_S)
         budget_s = self.auto_disarm_s() - self.rules.margin_s
         deadline = asked_at + self.rules.arm_timeout_s
         self.armed_at_s = {}

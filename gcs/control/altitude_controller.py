@@ -52,6 +52,10 @@ class AltitudeControllerParams:
     gains: PidGains = field(default_factory=_default_alt_gains)
     max_tilt_rad: float = math.radians(45.0)  # beyond this the cosine compensation stops growing
     hover_learn_tc_s: float = 10.0
+    # what a throttle held blind uses (`flown_hover`): the steady hover's level throttle over
+    # ~2 s; apm25 lockstep hold, seed 1: within 4 us of the mean command with 1 s (its noise),
+    # the 10 s learner 5 us under it (they start close there; on the real 3.2.1, 69 us apart)
+    flown_hover_tc_s: float = 2.0
     hover_learn_max_vel_mps: float = 0.2
     hover_learn_max_err_m: float = 0.1
     # All the climb the loop may ask (the output or the stick at its top, or P at its leash
@@ -64,8 +68,8 @@ class AltitudeControllerParams:
     throttle_max_us: int = 2000
 
     def __post_init__(self) -> None:
-        if self.mass_kg <= 0.0 or self.hover_learn_tc_s <= 0.0:
-            raise ValueError("mass_kg and hover_learn_tc_s must be > 0")
+        if self.mass_kg <= 0.0 or self.hover_learn_tc_s <= 0.0 or self.flown_hover_tc_s <= 0.0:
+            raise ValueError("mass_kg, hover_learn_tc_s and flown_hover_tc_s must be > 0")
         if not 0.0 < self.hover_min < self.hover_max < 1.0:
             raise ValueError("need 0 < hover_min < hover_max < 1")
 
@@ -98,6 +102,8 @@ class AltitudeController:
         self.pid = Pid(params.gains)
         h = curve.mid_output if hover_throttle is None else hover_throttle
         self.hover_throttle = min(max(h, params.hover_min), params.hover_max)
+        # the level throttle of the steady hover seen last, learned faster than hover_throttle
+        self.flown_hover = self.hover_throttle
         # which way the last stick command was clamped (+1 at the top, -1 at the bottom): the
         # integrator must not keep growing into a stick that cannot move further
         self._clamped = 0
@@ -135,6 +141,16 @@ class AltitudeController:
         """The stick PWM that holds the learned hover throttle, level."""
         p = self.params
         stick = self.curve.stick_us(self.hover_throttle)
+        return round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
+
+    def flown_hover_stick_us(self) -> int:
+        """The stick PWM the vehicle was last seen hovering on, level (`flown_hover`): what a
+        throttle held blind must be. The learned hover trails it with a 10 s time constant (a
+        hold started from 3.2.1's THR_MID still had 1439 us of "hover" against the vehicle's real
+        1370 us, and the throttle held blind on it climbed), and the integrator is no trim right
+        after an engage (it holds the pilot's stick then, bumpless)."""
+        p = self.params
+        stick = self.curve.stick_us(self.flown_hover)
         return round(min(max(stick, p.throttle_min_us), p.throttle_max_us))
 
     def update(self, setpoint_m: float, estimate: AltEstimate, roll_rad: float, pitch_rad: float,
@@ -197,6 +213,8 @@ class AltitudeController:
                   and not terms.saturated and not est.coasting and self._clamped == 0)
         if not steady:
             return
+        kf = dt_s / (dt_s + p.flown_hover_tc_s)
+        self.flown_hover += kf * (level_motor - self.flown_hover)
         # the throttle that holds the vehicle level (without the PID's acceleration) is hover;
         # the integrator then hands its share over to the learned value
         k = dt_s / (dt_s + p.hover_learn_tc_s)

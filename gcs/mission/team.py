@@ -156,8 +156,8 @@ class Team:
     def land(self) -> None:
         """Land every vehicle the station still flies, one after the other, where it is (see
         `_land_one`). One off the mission is left to what took it: the supervisor has
-        commanded LAND on a lost link and goes silent so that the firmware's failsafe lands
-        it; a LAND or a disarm of the autopilot's own stands."""
+        commanded LAND on a lost link and keeps asking it, with heartbeats, until the vehicle is
+        heard disarmed (or its own failsafe lands it); a LAND or a disarm of its own stands."""
         self.check()
         for v, c in self.crafts.items():
             c.phase = CraftPhase.LAND

@@ -4,6 +4,7 @@ ask for LAND when the loop itself has died with the vehicle possibly in the air.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 from firmware_link.records import FlightMode, Heartbeat, RcCommand
@@ -11,6 +12,9 @@ from gcs.supervisor import SupervisorState
 
 EMERGENCY_LAND_S = 3.0
 MODE_RESEND_S = 0.5
+DISARM_REPORT_S = 30.0  # a vehicle in LAND still armed after this is reported, each period
+STICK_MIN_US = 1000
+LANDING_MODES = frozenset({FlightMode.LAND, FlightMode.RTL})
 
 
 def let_go(link: Any, state: SupervisorState, hb: Heartbeat | None) -> str:
@@ -54,3 +58,41 @@ def emergency_land(link: Any, throttle_us: int, period_s: float,
     except Exception as exc:
         return str(exc) or type(exc).__name__
     return None
+
+
+def stay_until_disarmed(link: Any, throttle_us: int, period_s: float, say: Callable[[str], None],
+                        speedup: float = 1.0,
+                        report_s: float = DISARM_REPORT_S) -> Heartbeat | str:
+    """After LAND has shown: level, throttle minimum (LAND ignores the stick in the air;
+    ArduCopter 3.2.1 disarms after LAND only once it is at minimum), heartbeats (the link sends
+    them as it polls), until a heartbeat shows the vehicle disarmed (returned) or the link fails
+    (its error text). Should a heartbeat show another mode (a failsafe's RTL, a pilot's
+    STABILIZE), LAND is asked again, and outside LAND and RTL the throttle is `throttle_us` (the
+    safe hover), not the minimum. A vehicle still armed `report_s` after is reported through
+    `say`, again each period: nothing goes quiet on an armed vehicle (quiet, the landed 3.2.1 met
+    its GCS failsafe, whose RTL took it back up to 14 m). Times are the vehicle's."""
+    start = time.monotonic()
+    next_report = start + report_s / speedup
+    next_mode = 0.0
+    mode = int(FlightMode.LAND)
+    try:
+        while True:
+            for r in link.poll():
+                if isinstance(r, Heartbeat):
+                    if not r.armed:
+                        return r
+                    mode = r.mode
+            now = time.monotonic()
+            if mode != FlightMode.LAND and now >= next_mode:
+                link.send_set_mode(FlightMode.LAND)
+                next_mode = now + MODE_RESEND_S / speedup
+            if now >= next_report:
+                next_report = now + report_s / speedup
+                say(f"STILL ARMED {(now - start) * speedup:.0f} s after LAND showed: throttle "
+                    "minimum and heartbeats go on until it disarms (disarm it by hand, or "
+                    "kill; this process stays)")
+            thr = STICK_MIN_US if mode in LANDING_MODES else throttle_us
+            link.rc_override(RcCommand(1500, 1500, thr, 1500))
+            time.sleep(period_s / speedup)  # as emergency_land: no clock to wait on
+    except Exception as exc:
+        return str(exc) or type(exc).__name__

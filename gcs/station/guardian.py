@@ -15,9 +15,13 @@ time. So every station on a real link (TCP, UDP or serial) starts a guardian bes
   by itself (`gcs.station.exit`), and the guardian adds nothing.
 - A station that vanishes closes the socket without that word. If it was flying the vehicle,
   the guardian takes the link over at once and does what a dying station loop does: SET_MODE
-  LAND with the safe throttle, level, until a heartbeat shows LAND or disarmed, then releases
-  the overrides; with no such heartbeat within 3 s it goes silent, so the vehicle's own failsafe
-  (set up before flight) acts. It says what it did on the station's stderr and exits.
+  LAND with the safe throttle, level, until a heartbeat shows LAND or disarmed; then throttle
+  minimum and heartbeats until a heartbeat shows it disarmed (3.2.1 disarms after LAND only with
+  the throttle at minimum: a guardian that went quiet on the landed, armed vehicle had its GCS
+  failsafe RTL it back up to 14 m), reported loudly every 30 s while it stays armed, and only
+  then releases the overrides. With no heartbeat at all within 3 s (nothing heard) it goes
+  silent, so the vehicle's own failsafe (set up before flight) acts. It says what it did on the
+  station's stderr and exits.
 
 The guardian ignores SIGINT and runs in its own session: a Ctrl-C or a hang-up meant for the
 station reaches the station, whose exit the guardian then watches.
@@ -37,11 +41,13 @@ from typing import Any
 from firmware_link.connection import Transport
 from firmware_link.records import Heartbeat
 from gcs.core.landing import lands_on_death
-from gcs.station.exit import emergency_land, let_go
+from gcs.station.exit import emergency_land, let_go, stay_until_disarmed
 from gcs.station.types import StationSnapshot
 from gcs.supervisor import SupervisorState
 
-STAND_DOWN_WAIT_S = 1.0
+# A guardian just started is still importing pymavlink (1.0-1.3 s measured on a loaded 2-core
+# machine) before it reads the word to leave: waited 1 s, it was killed (exit -9) instead
+STAND_DOWN_WAIT_S = 5.0
 MESSAGE_BYTES = 65536
 THROTTLE_STEP_US = 2  # a safe throttle this much off what the guardian has is sent again
 HANDED_OVER = (Transport.TCP, Transport.UDPIN, Transport.UDPOUT, Transport.SERIAL)
@@ -181,10 +187,18 @@ def take_over(setup: GuardianSetup, fd: int, peer: tuple[object, ...] | None, th
     _say(f"the station stopped with vehicle {setup.target_system} in {state}: asking for LAND "
          f"(throttle {throttle_us} us until it shows)")
     hb = emergency_land(link, throttle_us, setup.period_s, speedup=setup.speedup)
+    if isinstance(hb, Heartbeat) and hb.armed:
+        _say(f"vehicle {setup.target_system} in LAND: throttle minimum and heartbeats until it "
+             "disarms")
+        hb = stay_until_disarmed(link, throttle_us, setup.period_s, _say, speedup=setup.speedup)
+        if not isinstance(hb, Heartbeat):
+            link.close()
+            _say(f"vehicle {setup.target_system} may still be armed: the link failed ({hb})")
+            return 1
     if isinstance(hb, Heartbeat):
         text = let_go(link, SupervisorState.QUITTING, hb)
         link.close()
-        _say(f"vehicle {setup.target_system} {'in LAND' if hb.armed else 'disarmed'}"
+        _say(f"vehicle {setup.target_system} disarmed"
              f"{': ' + text if text else ', overrides released'}")
         return 0
     link.close()

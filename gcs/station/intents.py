@@ -28,9 +28,10 @@ class StationIntents:
     def _intent(self, intent: Intent) -> None:
         self._intents.put(intent)
 
-    def request_arm(self) -> None:
-        """Ask the vehicle to arm (refused by the supervisor until pre-flight checks pass)."""
-        self._intent(Intent(IntentKind.ARM))
+    def request_arm(self, wait_s: float | None = None) -> None:
+        """Ask the vehicle to arm (refused by the supervisor until pre-flight checks pass),
+        again each second for `wait_s` (None: the supervisor's arm_timeout_s, a few seconds)."""
+        self._intent(Intent(IntentKind.ARM, wait_s=wait_s))
 
     def request_disarm(self) -> None:
         """Ask the vehicle to disarm."""

@@ -170,18 +170,21 @@ class Station(StationIntents):
     def _land(self, now: Callable[[], float], advance: Callable[[float], None]) -> None:
         """Land a vehicle that may fly before letting go: QUIT asked again each second (a QUIT
         is ignored while the link is lost, and the link may come back with the vehicle still to
-        be landed) until the supervisor lets go or its quit timeout passes. `advance(until)`
-        lets the loop run: a tick of a stepped station, a wait on the loop thread's."""
+        be landed) until the supervisor lets go, or its quit timeout passes with no LAND shown.
+        Once LAND has shown it stays until the vehicle is seen disarmed, however long (the
+        supervisor says so each `disarm_report_s`): quiet, a landed 3.2.1 meets its GCS
+        failsafe, whose RTL climbs. `advance(until)` lets the loop run: a tick of a stepped
+        station, a wait on the loop thread's."""
         if not must_land(self.snapshot(loop_stats=False).state):
             return
         deadline = now() + self.supervisor_params.quit_timeout_s
         next_ask = now()
-        while now() < deadline:
+        while now() < deadline or self.core.supervisor.waits_for_disarm:
             if now() >= next_ask:
                 self._intents.put(Intent(IntentKind.QUIT))
                 next_ask += 1.0
-            advance(min(next_ask, deadline))
-            if may_leave(self.snapshot(loop_stats=False).state):
+            advance(next_ask if now() >= deadline else min(next_ask, deadline))
+            if may_leave(self.snapshot(loop_stats=False).state) or not self._running:
                 break
 
     def _wait_until(self, until: float) -> None:

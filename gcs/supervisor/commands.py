@@ -70,6 +70,12 @@ class StateCommands:
         self._kill_at_s = -math.inf
         self._lost_at_s = -math.inf
         self._lost_throttle_us = STICK_MIN_US  # chosen when the link was lost, held through it
+        self._lost_height_m = 0.0  # above the rest height when the link was lost
+        self._lost_down = False  # a LAND asked on the lost link has had time to touch down
+        self._takeoff_asked_s = -math.inf  # a take-off asked while arming, waiting for the arm
+        self.arm_wait_s = params.arm_timeout_s  # how long the arm asked now is asked again
+        self._in_land_s: float | None = None  # quitting: when a heartbeat first showed LAND
+        self._disarm_report_s = math.inf  # quitting: when the next "still armed" is due
         self._next_send_s = -math.inf
         self._ramp_us = 0.0
         self._ramp_top_since_s: float | None = None
@@ -132,6 +138,12 @@ class StateCommands:
         self.alt_setpoint_m = None
         self._takeoff_wanted = False
 
+    @property
+    def waits_for_disarm(self) -> bool:
+        """Quitting with LAND shown: the station stays (throttle minimum, heartbeats) until a
+        heartbeat shows the vehicle disarmed, however long that takes."""
+        return self.state is S.QUITTING and self._in_land_s is not None
+
     def on_floor(self, alt_m: float) -> bool:
         """Whether an altitude estimate means standing on the floor."""
         return alt_m < self.ground_alt_m
@@ -149,19 +161,35 @@ class StateCommands:
         if st in (S.DISARMED, S.RELEASED):
             return (None if st is S.RELEASED else LEVEL), True
         if st is S.ARMING:
-            if self._t - self.since_s > self.p.arm_timeout_s:
-                self._go(S.DISARMED, f"vehicle did not arm within {self.p.arm_timeout_s:g} s",
-                         Level.ERROR)
+            if self._takeoff_wanted and self._t - self._takeoff_asked_s > self.p.takeoff_wait_s:
+                self._takeoff_wanted = False  # asked of an armed vehicle, not of a later one
+                self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING,
+                            f"take-off expired: the vehicle did not arm within "
+                            f"{self.p.takeoff_wait_s:g} s of it; ask again once armed")
+            if self._t - self.since_s > self.arm_wait_s:
+                self._takeoff_wanted = False
+                self._go(S.DISARMED, f"vehicle did not arm within {self.arm_wait_s:g} s: the arm "
+                         "request has expired, ask again", Level.ERROR)
                 self._went(OutcomeKind.ARM_TIMED_OUT)
             else:
                 self._send_every(self.p.arm_resend_s, Action(ActionKind.ARM))
             return LEVEL, True
         if st is S.LINK_LOST:
-            if self._t - self._lost_at_s >= self.p.land_request_s and self._link is LinkHealth.LOST:
-                self._go(S.SILENT, "still nothing heard: overrides and heartbeats stopped so the "
-                         "vehicle's own failsafe lands it", Level.ERROR)
-                return None, False
+            # LAND asked until the vehicle is heard again, heartbeats on (params: the policy)
             self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
+            p = self.p
+            down_s = (p.land_request_s + max(self._lost_height_m, 0.0) / p.land_speed_mps
+                      + p.landed_settle_s)
+            if (not self._lost_down and self._t - self._lost_at_s >= down_s
+                    and self._link is LinkHealth.LOST):
+                self._lost_down = True
+                self._note(Level.ERROR, f"still nothing heard {self._t - self._lost_at_s:.1f} s "
+                           "after LAND was first asked: it has touched down by now (ours or its "
+                           "failsafe's); throttle minimum so it disarms, heartbeats on until a "
+                           "heartbeat shows it disarmed")
+            if self._lost_down and (self._link is LinkHealth.LOST
+                                    or inp.vehicle.mode in LANDING_MODES):
+                return LEVEL, True
             return self._safe_hold(self._lost_throttle_us), True
         if st is S.SILENT:
             return None, False
@@ -169,6 +197,8 @@ class StateCommands:
             thr = STICK_MIN_US if inp.vehicle.mode in LANDING_MODES else STICK_MID_US
             return RcCommand(STICK_MID_US, STICK_MID_US, thr, STICK_MID_US), True
         if st is S.QUITTING:
+            if self._in_land_s is not None:
+                return self._stay_until_disarmed(inp), True
             if self._t - self.since_s > self.p.quit_timeout_s:
                 self._note(Level.ERROR, "quit: LAND not confirmed in time")
             self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
@@ -183,13 +213,32 @@ class StateCommands:
             return self._takeoff(inp), True
         return self._hold(inp), True
 
+    def _stay_until_disarmed(self, inp: TickIn) -> RcCommand:
+        """A quitting station whose LAND has shown: throttle minimum (LAND ignores the stick in
+        the air; 3.2.1 disarms after it only with the stick at minimum), level, heartbeats on,
+        until a heartbeat shows the vehicle disarmed (the supervisor then releases). Going quiet
+        on it instead lets 3.2.1's GCS failsafe RTL the landed vehicle back up (measured)."""
+        assert self._in_land_s is not None
+        if inp.vehicle.mode != FlightMode.LAND:  # moved on (a failsafe's RTL): LAND again
+            self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
+        if self._t >= self._disarm_report_s:
+            self._disarm_report_s = self._t + self.p.disarm_report_s
+            self._note(Level.ERROR, f"quit: still armed {self._t - self._in_land_s:.0f} s after "
+                       "LAND showed: throttle minimum and heartbeats go on until it disarms "
+                       "(disarm it by hand, or kill)")
+        if inp.vehicle.mode not in LANDING_MODES:
+            return self._safe_hold(self.safe_throttle_us(inp.estimate.alt_m))
+        return LEVEL
+
     def safe_throttle_us(self, alt_m: float) -> int:
         """The throttle for a vehicle that cannot be heard (or a loop that died): hover where it
-        flies, so it neither climbs nor falls; minimum on the floor, where hover throttle would
-        lift it (3.2.1's THR_MID is 1500 us); never above the pilot's own stick in MANUAL."""
+        flies (the hover the hold has learned, with its integrator's trim: the throttle it
+        actually holds at, not an assumed one), so it neither climbs nor falls; minimum on the
+        floor, where hover throttle would lift it (3.2.1's THR_MID is 1500 us); never above the
+        pilot's own stick in MANUAL."""
         if self.on_floor(alt_m):
             return STICK_MIN_US
-        hover = self.alt_ctrl.hover_stick_us()
+        hover = self.alt_ctrl.flown_hover_stick_us()
         if self.state is S.MANUAL:
             return min(hover, self.sticks.throttle_us if self.gate_us is None else self.gate_us)
         return hover

@@ -8,11 +8,17 @@ behaves, which the pre-flight checks make safe):
   the controller resumes when frames come back.
 - A gap over `lost_after_s` lands the vehicle: SET_MODE LAND every `mode_resend_s` for
   `land_request_s` while the uplink may still work, with that safe throttle in the overrides.
-- Still nothing heard after that: the station goes silent (no overrides, no heartbeats), so the
-  autopilot's own GCS failsafe fires whatever the state of the uplink. ArduCopter 3.2.1 fires it
-  5 s after the last heartbeat or override (and its radio failsafe 2 s after the last override
-  when no receiver is fitted); 4.x after FS_GCS_TIMEOUT, which the pre-flight checks require to be
-  shorter than RC_OVERRIDE_TIME, so the GCS failsafe lands it before the overrides lapse.
+- Still nothing heard after that: LAND keeps being asked, with heartbeats, until a heartbeat
+  shows the vehicle disarmed; nothing goes quiet on a vehicle that may still be armed. If the
+  uplink works the vehicle is in LAND (it accepts LAND in every state it can fly in); if it does
+  not, what the station sends never arrives and the autopilot's own GCS failsafe lands it
+  (3.2.1 5 s after the last heartbeat or override; 4.x after FS_GCS_TIMEOUT, which the pre-flight
+  checks require to act, and to land). Once a LAND from the height last seen has had time to
+  touch down (`land_speed_mps`, `landed_settle_s`) the throttle goes to minimum: ArduCopter 3.2.1
+  disarms after LAND only with the throttle at minimum, and a station that then went quiet left
+  it landed and armed to its GCS failsafe, whose RTL took it back up to 14 m (measured).
+  By then either firmware is in LAND (ours, or its failsafe's, which ignores the stick), so the
+  minimum cannot drop a vehicle that still flies on the station's throttle.
 - When the link returns nothing resumes: a vehicle in LAND is left landing, a disarmed one stays
   disarmed, one still in STABILIZE keeps being asked to LAND. The pilot re-engages.
 - Motion capture is not used to keep flying through a loss: it tells where the vehicle is, not
@@ -39,11 +45,18 @@ class SupervisorParams:
     # ArduCopter 3.2.1 goes quiet for up to ~1 s while it arms (it recalibrates the barometer
     # in its main loop: the fixture tlog has gaps of 0.85 s and 1.01 s), so 1.5 s, not less
     lost_after_s: float = 1.5
-    land_request_s: float = 3.0  # LAND commanded this long before going silent
+    land_request_s: float = 3.0  # LAND asked with the hover this long, then its descent counts
     mode_resend_s: float = 0.5
     disarm_resend_s: float = 0.2  # kill: ≥ 5 Hz
     arm_resend_s: float = 1.0
-    arm_timeout_s: float = 30.0
+    # A pilot's arm is asked again each arm_resend_s for this long, then expires and says so: on
+    # the real 4.7 (pre-arm refused ~24 s after boot) an arm kept asked for 30 s armed the vehicle
+    # by itself 20 s after the key. A launch that means to wait asks for longer (Intent.wait_s).
+    arm_timeout_s: float = 5.0
+    # A take-off asked while arming waits this long for the arm, then expires and says so: on
+    # the real 4.7 a take-off key pressed while pre-arm refused stayed queued and the vehicle
+    # took off by itself when it armed 20 s later.
+    takeoff_wait_s: float = 3.0
     # After arming, motors held at minimum: ArduCopter 4.x keeps them there ~2 s, then spools up
     # over MOT_SPOOL_TIME (0.5 s); 3.2.1 spins at once.
     spool_s: float = 0.5
@@ -59,6 +72,14 @@ class SupervisorParams:
     liftoff_lag_s: float = 0.3  # the ramp's last stretch, spent before lift-off was seen
     pickup_band_us: int = 25  # the pilot's throttle takes over within this of the held one
     quit_timeout_s: float = 10.0  # a quitting station waits this long for LAND to show
+    # Both firmwares' LAND sinks at LAND_SPEED 50 cm/s below 10 m; their land detectors then take
+    # about a second (3.2.1) to decide, with a margin: a LAND asked on a lost link is taken to
+    # have touched down after land_request_s + height / land_speed_mps + landed_settle_s.
+    land_speed_mps: float = 0.5
+    landed_settle_s: float = 3.0
+    # A vehicle in LAND that has not disarmed this long after LAND showed is reported (again
+    # each period); throttle minimum and heartbeats go on until it is seen disarmed.
+    disarm_report_s: float = 30.0
     # The hold asking for nearly all the climb it may (AltitudeControllerParams) this long
     # while the estimate does not rise: a vehicle given +3 m/s² for a second climbs 3 m/s, so
     # either the estimate is not the vehicle's (it was pinned to the floor of a carpet while the
@@ -90,9 +111,9 @@ class SupervisorParams:
         if not 0.0 < self.degraded_after_s < self.lost_after_s:
             raise ValueError("need 0 < degraded_after_s < lost_after_s")
         if min(self.blind_s, self.blind_band_m, self.blind_steady_mps,
-               self.blind_touchdown_mps) <= 0.0:
-            raise ValueError("blind_s, blind_band_m, blind_steady_mps and blind_touchdown_mps "
-                             "must be > 0")
+               self.blind_touchdown_mps, self.land_speed_mps, self.disarm_report_s) <= 0.0:
+            raise ValueError("blind_s, blind_band_m, blind_steady_mps, blind_touchdown_mps, "
+                             "land_speed_mps and disarm_report_s must be > 0")
         if self.blind_brake_factor < 1.0:
             raise ValueError("blind_brake_factor must be >= 1 (it brakes a climb at least as "
                              f"hard as stopping it needs), got {self.blind_brake_factor}")

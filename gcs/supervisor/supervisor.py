@@ -89,7 +89,7 @@ class Supervisor(StateCommands):
         elif self.state in (S.LINK_LOST, S.SILENT, S.QUITTING):
             self._ignored(k, f"{k.value} ignored while {self.state.value}")
         elif k is IntentKind.ARM:
-            self._arm()
+            self._arm(it.wait_s)
         elif k is IntentKind.DISARM:
             self._actions.append(Action(ActionKind.DISARM))
             self._note(Level.INFO, "disarm requested")
@@ -119,7 +119,8 @@ class Supervisor(StateCommands):
         else:
             self._note(Level.WARNING, text)
 
-    def _arm(self) -> None:
+    def _arm(self, wait_s: float | None) -> None:
+        self.arm_wait_s = self.p.arm_timeout_s if wait_s is None else wait_s
         if self.state is not S.DISARMED:
             self._ended(OutcomeKind.ARM_IGNORED, Level.WARNING,
                         f"arm ignored: already {self.state.value}")
@@ -134,6 +135,10 @@ class Supervisor(StateCommands):
                    f"the vehicle flies itself in {mode_name(inp.vehicle.mode)}; "
                    "switch to STABILIZE first")
             if self.state is S.ARMING:
+                if not self._takeoff_wanted:
+                    self._takeoff_asked_s = self._t
+                    self._note(Level.INFO, f"take-off waits up to {self.p.takeoff_wait_s:g} s "
+                               "for the arm")
                 self._takeoff_wanted = True
                 self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
                 return
@@ -165,8 +170,10 @@ class Supervisor(StateCommands):
         elif self.state in (S.SILENT, S.LINK_LOST):
             self._note(Level.WARNING, f"quit while {self.state.value}: the vehicle's own "
                        "failsafe lands it")
-        else:
-            self._go(S.QUITTING, "quit while armed: LAND first, then release", Level.WARNING)
+        elif self.state is not S.QUITTING:  # asked again (each second) while it lands
+            self._in_land_s = None
+            self._go(S.QUITTING, "quit while armed: LAND first, then release once disarmed",
+                     Level.WARNING)
 
     def _release(self, reason: str) -> None:
         self._end_pc_control()
@@ -179,6 +186,8 @@ class Supervisor(StateCommands):
             return
         self._lost_at_s = self._t
         self._lost_throttle_us = self.safe_throttle_us(inp.estimate.alt_m)
+        self._lost_height_m = inp.estimate.alt_m - self.rest_alt_m
+        self._lost_down = False
         self._end_pc_control()
         self._go(S.LINK_LOST, f"nothing heard from the vehicle for "
                  f"{inp.vehicle.frame_age_s:.1f} s: commanding LAND", Level.ERROR)
@@ -214,8 +223,11 @@ class Supervisor(StateCommands):
                 self._to_manual("armed", STICK_MIN_US)
             self._went(OutcomeKind.ARMED)
         elif st is S.QUITTING:
-            if v.mode == FlightMode.LAND:
-                self._release("vehicle in LAND: overrides released")
+            if v.mode == FlightMode.LAND and self._in_land_s is None:
+                self._in_land_s = self._t
+                self._disarm_report_s = self._t + self.p.disarm_report_s
+                self._note(Level.INFO, "quit: vehicle in LAND: throttle minimum and heartbeats "
+                           "until it disarms, then overrides released")
         elif st is S.LINK_LOST:
             if v.mode == FlightMode.LAND:
                 self._go(S.VEHICLE, "the vehicle is heard again and lands in LAND")

@@ -87,6 +87,9 @@ class Intent:
     yaw_rad: float | None = None
     ok: bool = False  # PREFLIGHT
     note: str = ""  # PREFLIGHT: why not, or what was checked
+    # ARM: how long to keep asking (None: SupervisorParams.arm_timeout_s, a pilot's few seconds;
+    # a launch that waits out 4.x's ~24 s pre-arm asks for longer)
+    wait_s: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

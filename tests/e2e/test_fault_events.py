@@ -80,13 +80,13 @@ Trigger = Callable[[subprocess.Popen[str], FaultProxy, MavWatcher], None]
 
 
 @contextlib.contextmanager
-def _rig(profile: str, speedup: float, transport: str = "tcp",
+def _rig(profile: str, speedup: float, transport: str = "tcp", sitl_args: tuple[str, ...] = (),
          ) -> Iterator[tuple[Any, MavWatcher, MavWatcher, FaultProxy, StationTap]]:
     udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     udp.bind(("127.0.0.1", 0))
     args = ["--tcp", "0", "--profile", profile, "--speedup", f"{speedup:g}", "--seed", "4",
             "--udp", f"127.0.0.1:{udp.getsockname()[1]}",
-            *(["--serial"] if transport == "serial" else [])]
+            *(["--serial"] if transport == "serial" else []), *sitl_args]
     with contextlib.ExitStack() as stack:
         sitl = stack.enter_context(_sitl(args))
         watch_udp = MavWatcher(udp, udp=True)
@@ -111,10 +111,11 @@ def _rig(profile: str, speedup: float, transport: str = "tcp",
 
 def fly(profile: str, trigger: Trigger, *, phase: str = "hold", after_s: float = 3.0,
         extra: tuple[str, ...] = (), watch_s: float = 25.0, speedup: float = SPEEDUP,
-        transport: str = "tcp") -> Run:
+        transport: str = "tcp", sitl_args: tuple[str, ...] = ()) -> Run:
     """Fly 1 m; `after_s` simulated seconds into `phase` (seen on --live) call `trigger`; keep
     watching for `watch_s` simulated seconds after it."""
-    with _rig(profile, speedup, transport) as (sitl, watch_udp, watch_mocap, proxy, tap):
+    with _rig(profile, speedup, transport, sitl_args) as (sitl, watch_udp, watch_mocap, proxy,
+                                                          tap):
         argv = [sys.executable, "-m", "gcs", "fly", "--connect", sitl.connect, "--mocap",
                 sitl.mocap_url, "--profile", profile, "--alt", f"{SETPOINT_M}", "--hold", "20",
                 "--json", "--live", "--no-record", "--speedup", f"{speedup:g}", "--fix-failsafe",
@@ -172,18 +173,32 @@ def _lands_safely(r: Run) -> None:
     assert float(r.alt_m.max()) <= SETPOINT_M + 0.3, f"rose to {float(r.alt_m.max()):.2f} m"
 
 
-@pytest.mark.parametrize(("profile", "transport"),
-                         [("apm25", "tcp"), ("copter4", "tcp"), ("apm25", "serial")])
-def test_station_sigkilled_mid_air_is_landed_by_its_guardian(profile: str,
-                                                             transport: str) -> None:
+@pytest.mark.parametrize(("profile", "transport", "sitl_args"),
+                         [("apm25", "tcp", ()), ("apm25", "tcp", ("--no-gps",)),
+                          ("copter4", "tcp", ()), ("apm25", "serial", ())],
+                         ids=["apm25-tcp-gps-rtl-alt-0", "apm25-tcp-no-gps", "copter4-tcp",
+                              "apm25-serial"])
+def test_station_sigkilled_mid_air_is_landed_by_its_guardian(
+        profile: str, transport: str, sitl_args: tuple[str, ...]) -> None:
     """Without its guardian (gcs/station/guardian.py) the vehicle flew the last override blind until
-    its failsafe: up to 1.86 m from a 1 m hold, or into the floor at 1.02 m/s."""
+    its failsafe: up to 1.86 m from a 1 m hold, or into the floor at 1.02 m/s. The receiver is
+    at minimum (the SITL's default, as the fixtures' simulators); apm25 with a GPS has RTL_ALT 0
+    from --fix-failsafe. The guardian stays after LAND, throttle minimum and heartbeats, until
+    the vehicle is seen disarmed (#32: until then it released the overrides once LAND showed and
+    went quiet, and the real 3.2.1, landed and armed, was taken back up to 14 m by its GCS
+    failsafe's RTL); nothing lifts it again in the rest of the watch."""
     r = fly(profile, lambda proc, _p, _w: proc.send_signal(signal.SIGKILL),
-            transport=transport, speedup=SPEEDUP if transport == "tcp" else 2.0)
+            transport=transport, speedup=SPEEDUP if transport == "tcp" else 2.0,
+            sitl_args=sitl_args)
     assert r.exit_code == -signal.SIGKILL
     assert "guardian: the station stopped with vehicle 1 in hold: asking for LAND" in r.stderr
-    assert "guardian: vehicle 1 in LAND, overrides released" in r.stderr, r.stderr[-500:]
+    assert "guardian: vehicle 1 in LAND: throttle minimum and heartbeats" in r.stderr
+    assert "guardian: vehicle 1 disarmed, overrides released" in r.stderr, r.stderr[-500:]
     _lands_safely(r)
+    off = r.disarmed_s()
+    assert off is not None
+    assert float(r.alt_m[r.t_s >= off].max()) <= REST_ALT_M + FLOOR_BAND_M  # no re-launch
+    assert not [t for t, armed, _ in r.heartbeats if t > off and armed]
 
 
 def test_auto_disarm_before_takeoff_is_reported_and_nothing_winds_up() -> None:

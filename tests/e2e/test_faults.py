@@ -8,9 +8,10 @@ Height is judged from motion capture, which the fault does not touch; the vehicl
 state, mode and failsafe texts from a UDP endpoint of the SITL that only listens.
 
 What the station's policy promises: proof of life is any frame; a short gap holds a safe
-command; a gap over ~1 s makes it request LAND for a few seconds, then stop heartbeats and
-overrides so the autopilot's own failsafe acts if the uplink is dead too; nothing resumes when
-the link returns. So for a lost link, one way or both: never above setpoint + 0.3 m, touchdown
+command; a gap over ~1 s makes it request LAND, with heartbeats, until the vehicle is heard
+again (its throttle at minimum once that LAND has had time to touch down, so 3.2.1 disarms; the
+autopilot's own failsafe acts if the uplink is dead too; `fly` lets go after its quit timeout);
+nothing resumes when the link returns. So for a lost link, one way or both: never above setpoint + 0.3 m, touchdown
 no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault (where the uplink is
 dead, plus the descent at the firmware's LAND speed from any height the open-loop seconds
 climbed past the bound: in lockstep, apm25 fades that reached the ceiling disarmed 16.3 and

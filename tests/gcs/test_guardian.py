@@ -65,16 +65,50 @@ def _die(guardian: Guardian) -> int:
     return guardian._proc.wait(EXIT_S)
 
 
+def _die_and_disarm(v: FakeVehicle, guardian: Guardian, stay_s: float = 0.0) -> int:
+    """The station dies; once the guardian has LAND and sends the throttle at minimum, the
+    fake vehicle stays armed `stay_s` more (landing, then 3.2.1 landed waiting for the stick),
+    then disarms as 3.2.1 does after LAND with the throttle at minimum. The guardian's exit."""
+    guardian._sock.close()
+    assert wait_until(lambda: v.state.mode == int(FlightMode.LAND)
+                      and bool(v.state.overrides) and v.state.overrides[-1][2][2] == 1000,
+                      EXIT_S)
+    if stay_s:
+        time.sleep(stay_s)  # the time a vehicle stays armed: the guardian must not leave in it
+        assert guardian._proc.poll() is None
+    v.state.armed = False
+    return guardian._proc.wait(EXIT_S)
+
+
 def test_a_station_that_dies_flying_has_the_vehicle_landed(flying) -> None:
+    """Landed, it stays (throttle minimum, heartbeats) until the vehicle is seen disarmed: until
+    #32 it released the overrides once LAND showed and went quiet, and the real 3.2.1, still
+    armed on the floor, met its GCS failsafe, whose RTL took it back up to 14 m."""
     v, _link, guardian = flying
     guardian.on_snapshot(_snapshot(SupervisorState.HOLD))
     before = len(v.state.overrides)
-    assert _die(guardian) == 0
+    assert _die_and_disarm(v, guardian, stay_s=2.5) == 0
     assert v.state.mode == int(FlightMode.LAND)
     assert v.state.refused == 0  # a signed link stays signed
     sent = [chans for _, _, chans in v.state.overrides[before:]]
     assert sent and sent[0][:4] == (1500, 1500, HOVER_US, 1500)  # level, hover, until LAND
+    firsts = [i for i, c in enumerate(sent) if c[2] == 1000]
+    # then level at minimum, nothing released, until the vehicle is seen disarmed
+    assert all(c[:4] == (1500, 1500, 1000, 1500) for c in sent[firsts[0]:-1])
+    assert len(sent) - firsts[0] >= 2.0 / 0.025 / 2  # through the 2.5 s it stayed armed
     assert sent[-1] == (0,) * 8  # then handed back to the radio
+
+
+def test_a_guardian_keeps_heartbeats_while_the_landed_vehicle_stays_armed() -> None:
+    with _guarded("apm25") as (v, _link, guardian):
+        guardian.on_snapshot(_snapshot(SupervisorState.HOLD))
+        guardian._sock.close()
+        assert wait_until(lambda: v.state.mode == int(FlightMode.LAND), EXIT_S)
+        hb0 = v.state.gcs_heartbeats
+        time.sleep(3.2)
+        assert guardian._proc.poll() is None and v.state.gcs_heartbeats - hb0 >= 2
+        v.state.armed = False
+        assert guardian._proc.wait(EXIT_S) == 0
 
 
 def test_a_station_that_stands_down_leaves_the_link_alone(flying) -> None:
@@ -141,7 +175,7 @@ def test_a_reopened_link_is_handed_over_again() -> None:
             for r in link.poll()), 10.0)
         v.state.armed = True
         guardian.on_snapshot(_snapshot(SupervisorState.HOLD))
-        assert _die(guardian) == 0
+        assert _die_and_disarm(v, guardian) == 0
         assert v.state.mode == int(FlightMode.LAND)
 
 

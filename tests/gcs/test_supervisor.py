@@ -165,8 +165,9 @@ def test_kill_on_apm25_in_land_switches_to_stabilize_so_disarm_is_accepted() -> 
 def test_short_gap_holds_hover_throttle_level_then_hold_resumes() -> None:
     s = Script()
     s.hovering()
-    s.run(1.0)
-    hover = s.sup.alt_ctrl.hover_stick_us()
+    s.run(12.0)  # steady long enough for the flown hover (2 s time constant) to settle
+    # the hover the hold flies at: learned, with its integrator's trim (#32)
+    hover = s.sup.alt_ctrl.flown_hover_stick_us()
     s.down = False
     outs = s.run(0.6)
     held = [o for o in outs if o.link is LinkHealth.DEGRADED]
@@ -201,7 +202,7 @@ def test_link_lost_in_manual_flight_never_raises_the_pilots_throttle() -> None:
     s.tick(Intent(IntentKind.STICKS, throttle_us=1350))  # descending, below hover
     s.alt = 1.2
     s.run(0.5)
-    hover = s.sup.alt_ctrl.hover_stick_us()
+    hover = s.sup.alt_ctrl.flown_hover_stick_us()
     assert hover > 1350
     s.down = False
     outs = s.run(2.0)
@@ -209,11 +210,14 @@ def test_link_lost_in_manual_flight_never_raises_the_pilots_throttle() -> None:
     assert all(o.command is not None and o.command.throttle_us <= 1350 for o in outs)
 
 
-def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
+def test_long_gap_lands_stays_until_disarmed_and_nothing_resumes() -> None:
+    """Until #32 the station went silent 3 s after the loss; on the real 3.2.1 a landed, armed
+    vehicle then met its GCS failsafe, whose RTL climbed to 14 m. Now LAND and heartbeats go
+    on, the throttle at minimum once a LAND from the height last seen has touched down."""
     s = Script()
     s.hovering()
-    s.run(1.0)
-    hover = s.sup.alt_ctrl.hover_stick_us()
+    s.run(12.0)  # steady long enough for the flown hover (2 s time constant) to settle
+    hover = s.sup.alt_ctrl.flown_hover_stick_us()
     s.down = False
     outs = s.run(1.6)
     assert s.sup.state is S.LINK_LOST
@@ -224,9 +228,21 @@ def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
     lands = actions(outs, ActionKind.SET_MODE)
     assert lands and all(m == FlightMode.LAND for m in lands)
     assert len(lands) >= 5  # every 0.5 s while the uplink may work
-    outs = s.run(0.5)
-    assert s.sup.state is S.SILENT
-    assert all(o.command is None and not o.heartbeat for o in outs[-5:])
+    # LAND from 0.94 m over the rest: touched down 3 + 0.94 / 0.5 + 3 s after the loss
+    lost_at = s.sup._lost_at_s
+    outs = s.run(5.5)
+    assert s.sup.state is S.LINK_LOST
+    assert all(o.heartbeat and o.command is not None for o in outs)
+    down = [s.t - 5.5 + 0.025 * (i + 1) for i, o in enumerate(outs)
+            if o.command is not None and o.command.throttle_us == 1000]
+    assert down and down[0] - lost_at == pytest.approx(3.0 + 0.94 / 0.5 + 3.0, abs=0.03)
+    assert all(abs(o.command.throttle_us - hover) <= 3 for o in outs[:len(outs) - len(down)]
+               if o.command is not None)
+    assert any("throttle minimum so it disarms" in n.text for o in outs for n in o.notes)
+    outs = s.run(30.0)  # never quiet while it may be armed
+    assert all(o.heartbeat and o.command is not None and o.command.throttle_us == 1000
+               for o in outs)
+    assert len(actions(outs, ActionKind.SET_MODE)) >= 55
     # the link comes back with the vehicle still in STABILIZE: keep asking for LAND
     s.down = True
     s.heartbeat_now()
@@ -240,6 +256,7 @@ def test_long_gap_lands_then_goes_silent_and_nothing_resumes() -> None:
     assert s.sup.state is S.VEHICLE
     out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=1.0))
     assert s.sup.state is S.VEHICLE and any("refused" in n.text for n in out.notes)
+    assert out.command is not None and out.command.throttle_us == 1000 and out.heartbeat
 
 
 def test_land_mode_by_itself_ends_pc_control_and_stabilize_keeps_throttle_at_minimum() -> None:
@@ -386,7 +403,10 @@ def test_an_estimate_rebased_on_another_surface_moves_no_stick(status: SonarStat
         assert s.sup.alt is not None and s.sup.alt.saturated
 
 
-def test_quit_while_hovering_lands_first_and_releases_after_land_is_seen() -> None:
+def test_quit_while_hovering_lands_first_and_releases_once_disarmed() -> None:
+    """Until #32 the overrides were released as soon as LAND showed; a 3.2.1 whose throttle
+    channel then stayed above minimum stood landed and armed, and met its GCS failsafe once the
+    station had gone (test_stay_until_disarmed has the rest)."""
     s = Script()
     s.hovering()
     out = s.tick(Intent(IntentKind.QUIT))
@@ -394,6 +414,12 @@ def test_quit_while_hovering_lands_first_and_releases_after_land_is_seen() -> No
     assert any(a.kind is ActionKind.SET_MODE and a.mode == FlightMode.LAND for a in out.actions)
     assert out.command is not None and out.command.throttle_us > 1000  # still holding
     s.mode = int(FlightMode.LAND)
+    s.heartbeat_now()
+    out = s.tick()
+    assert s.sup.state is S.QUITTING and not any(a.kind is ActionKind.RELEASE
+                                                 for a in out.actions)
+    assert out.command is not None and out.command.throttle_us == 1000 and out.heartbeat
+    s.armed = False
     s.heartbeat_now()
     out = s.tick()
     assert s.sup.state is S.RELEASED and any(a.kind is ActionKind.RELEASE for a in out.actions)

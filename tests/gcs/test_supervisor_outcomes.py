@@ -39,7 +39,8 @@ def test_an_arm_the_vehicle_never_takes_times_out_once_after_the_arm_timeout() -
     assert kinds(outs) == [OutcomeKind.ARM_TIMED_OUT]
     ended = next(o for out in outs for o in out.outcomes)
     assert 5.0 < ended.t_s - asked.transitions[0].t_s <= 5.0 + DT + 1e-9
-    assert ended.note == "disarmed: vehicle did not arm within 5 s"
+    assert ended.note == ("disarmed: vehicle did not arm within 5 s: the arm request has expired, "
+                          "ask again")
     assert s.sup.state is S.DISARMED and said_as_notes(s.outs)
 
 

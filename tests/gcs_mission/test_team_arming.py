@@ -41,7 +41,7 @@ class FakeStation:
     def set_mode(self, mode: FlightMode) -> None:
         self.mode = int(mode)
 
-    def request_arm(self) -> None:
+    def request_arm(self, wait_s: float | None = None) -> None:
         self.asked_s = self.clock.now_s()
 
     def request_disarm(self) -> None:
