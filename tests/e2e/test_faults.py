@@ -11,15 +11,15 @@ What the station's policy promises: proof of life is any frame; a short gap hold
 command; a gap over ~1 s makes it request LAND, with heartbeats, until the vehicle is heard
 again (its throttle at minimum once that LAND has had time to touch down, so 3.2.1 disarms; the
 autopilot's own failsafe acts if the uplink is dead too; `fly` lets go after its quit timeout);
-nothing resumes when the link returns. So for a lost link, one way or both: never above setpoint + 0.3 m, touchdown
-no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault (where the uplink is
-dead, plus the descent at the firmware's LAND speed from any height the open-loop seconds
-climbed past the bound: in lockstep, apm25 fades that reached the ceiling disarmed 16.3 and
-16.6 s after the fault, against 9.3-13.9 s for the other 58 of 60; bench/open_loop.py), `fly`
-exits 3 with a reason line, and a station that cannot see the vehicle asks for LAND more than
-once (what it sent is read off the uplink by a tap in the proxy, whether the frames got through
-or not).
-With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m and exits 0.
+nothing resumes when the link returns. So for a lost link, one way or both: never above setpoint
++ 0.3 m, touchdown no faster than 1.0 m/s, on the floor and disarmed within 20 s of the fault
+(where the uplink is dead, plus the descent at the firmware's LAND speed from any height the
+open-loop seconds climbed past the bound: in lockstep, apm25 fades that reached the ceiling
+disarmed 16.3 and 16.6 s after the fault, against 9.3-13.9 s for the other 58 of 60;
+bench/open_loop.py), `fly` exits 3 with a reason line, and a station that cannot see the vehicle
+asks for LAND more than once (what it sent is read off the uplink by a tap in the proxy, whether
+the frames got through or not). With 30 % loss and 5 % bit flips it keeps holding within ±0.1 m
+and exits 0.
 
 The matrix is flown once per session (a module fixture, only the selected cases), in real time
 three flights at a time, or QUADGCS_FAULT_SPEEDUP=K times faster (tests/e2e/fault_flight.py).
