@@ -16,8 +16,10 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.mark.timeout(240)
 def test_fly_json_reports_bias_spread_and_the_truth_it_used() -> None:
     proc = subprocess.run(
+        # pinned to copter4 (whole-cm rangefinder): this test is about the scoring; over the
+        # real 3.2.1's analog sonar the station's hold is biased ≈ 5 cm (#32, test_hold_quality)
         [sys.executable, "-m", "gcs", "fly", "--json", "--no-record", "--seed", "3",
-         "--hold", "5", "--speedup", "4"],
+         "--hold", "5", "--speedup", "4", "--profile", "copter4", "--fix-failsafe"],
         capture_output=True, text=True, timeout=220, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     s = json.loads(proc.stdout.strip().splitlines()[-1])

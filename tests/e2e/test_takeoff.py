@@ -43,7 +43,15 @@ def _read(path: Path) -> dict[str, list[tuple[float, Any]]]:
 @pytest.mark.e2e
 @pytest.mark.timeout(240)
 @pytest.mark.parametrize(("how", "profile", "alt_m"), [
-    ("lockstep", "apm25", 1.0), ("lockstep", "apm25", 2.0), ("lockstep", "copter4", 1.0),
+    # with the real 3.2.1 analog sonar (nothing used below 20 cm, 6 cm steps) the station's
+    # take-off overshoots as on the real 3.2.1 (14.5-22.8 % to 1 m, 8.1 % to 2 m; issue 32)
+    pytest.param("lockstep", "apm25", 1.0, marks=pytest.mark.xfail(strict=True, reason=(
+        "#32: take-off through the sonar's blind band overshoots 16.0 % to 1 m (peak 1.160 m; "
+        "real 3.2.1 14.5-22.8 %)"))),
+    pytest.param("lockstep", "apm25", 2.0, marks=pytest.mark.xfail(strict=True, reason=(
+        "#32: take-off through the sonar's blind band overshoots 7.1 % to 2 m (peak 2.141 m; "
+        "real 3.2.1 8.1 %)"))),
+    ("lockstep", "copter4", 1.0),
     ("lockstep", "copter4", 2.0), ("tcp", "copter4", 2.0)])
 def test_takeoff_waits_for_the_motors_and_overshoots_at_most_5_percent(
         tmp_path: Path, how: str, profile: str, alt_m: float) -> None:
