@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from sitl.autopilot.failsafe_rules import (
@@ -19,7 +21,7 @@ FLYING = Situation(armed=True, mode=FlightMode.STABILIZE, landed=False, throttle
 
 
 def _in(mode: FlightMode, **kw: bool) -> Situation:
-    return Situation(**{**FLYING.__dict__, "mode": mode, **kw})
+    return dataclasses.replace(FLYING, mode=mode, **kw)  # no __dict__ on the compiled SITL
 
 
 @pytest.mark.parametrize("mode", [FlightMode.STABILIZE, FlightMode.ALT_HOLD])
