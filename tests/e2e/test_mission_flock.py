@@ -78,17 +78,12 @@ FADE_AT_S = 80.0  # simulated time: the team is in formation on its way to the c
 
 @pytest.mark.e2e
 @pytest.mark.timeout(300)
-@pytest.mark.xfail(strict=True, reason=(
-    "#32: the real 3.2.1 answers a GCS silence of 5 s with RTL when it has GPS and home (the "
-    "SITL's default now, as the real simulators): vehicle 3 climbs toward RTL_ALT 15 m into the "
-    "2.9 m ceiling, and the LAND the station asks once the link is back descends from the "
-    "estimate's 6.7 m, so it is still armed in the air when the mission quits. The station "
-    "neither refuses nor fixes that failsafe configuration before flying (pre-flight checks "
-    "only that FS_GCS_ENABLE is on)"))
 def test_one_vehicles_radio_fade_ends_the_mission_safely_for_all_five(tmp_path: Path) -> None:
     # lockstep: the five stations and the SITL on one simulated clock, vehicle 3's radio
     # dead both ways for 10 s; the mission stops, the others land, vehicle 3's own failsafe
-    # lands it, and nobody relaunches it when its link comes back
+    # lands it, and nobody relaunches it when its link comes back. The vehicles are 3.2.1s
+    # with no GPS fix (indoors): the GCS failsafe lands them (with a fix the pre-flight refuses
+    # RTL_ALT 1500, tests/e2e/test_preflight_failsafe.py)
     from gcs.mission.options import RunOptions
     from gcs.mission.runner import run_mission
     from gcs.mission.spec import load_mission

@@ -105,7 +105,7 @@ def test_without_the_truth_the_sitl_flight_maps_unscored_and_its_map_scores_afte
     # where they are. (Sped up over TCP at 4x the telemetry came in bursts; at 2x the flight
     # took five minutes of the suite.)
     proc = subprocess.run(
-        [sys.executable, "-m", "gcs", "mission", "run",
+        [sys.executable, "-m", "lab", "mission", "run",
          str(ROOT / "missions" / "radiation_3src.toml"), "--lockstep", "--seed", "3",
          "--no-truth", "--json", "-o", str(tmp_path)],
         capture_output=True, text=True, timeout=280, check=False)
