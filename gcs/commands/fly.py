@@ -31,7 +31,7 @@ from gcs.station.session import StationSession
 from gcs.station.station import StationSnapshot
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `fly` subcommand."""
     p = sub.add_parser("fly", help="hold an altitude under the PC controller, then land",
                        description=__doc__)
