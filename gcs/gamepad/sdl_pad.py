@@ -53,7 +53,7 @@ def init_sdl() -> ModuleType:
         raise RuntimeFault(f"gamepad: SDL did not start: {_error(sdl2)}")
     sdl2.SDL_JoystickEventState(sdl2.SDL_IGNORE)
     sdl2.SDL_GameControllerEventState(sdl2.SDL_IGNORE)
-    module: ModuleType = sdl2  # pysdl2 ships no types: the module is Any to the checker
+    module: ModuleType = sdl2  # pysdl2 ships no types: an untyped module to the checker
     return module
 
 

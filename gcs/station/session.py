@@ -37,6 +37,7 @@ from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlOptions, SitlProcess
 from gcs.station.guardian import Guardian, GuardianSetup
 from gcs.station.station import Station
+from gcs.station.types import clock_speedup
 from gcs.toml_file import read_signing_key
 
 CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
@@ -276,7 +277,7 @@ class StationSession:
                           clock=self.clock)
         guardian = Guardian.start(link, GuardianSetup(
             link.spec, link.firmware, link.target_system, link.target_component, key,
-            config.period_s, getattr(self.clock, "speedup", 1.0)))
+            config.period_s, clock_speedup(self.clock)))
         if guardian is not None:
             station.add_listener(guardian.on_snapshot)
             # after the station's own landing and letting go, before the link closes: a

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 from firmware_link.records import (
     Attitude,
+    Dialect,
     FlightMode,
     Heartbeat,
     Imu,
@@ -17,6 +18,8 @@ from firmware_link.records import (
     SimTruth,
     TelemetryRecord,
 )
+from firmware_link.stats import LinkStats
+from gcs.clock import Clock
 from gcs.control.altitude_controller import AltControlOutput
 from gcs.control.position_controller import PositionCommand, PositionSetpoint
 from gcs.estimation import AltEstimate
@@ -81,7 +84,7 @@ class StationSnapshot:
     throttle_gate_us: int | None
     hover_throttle: float
     loop: LoopStats
-    link_stats: Any
+    link_stats: LinkStats
     events: tuple[StationEvent, ...]
     listener_errors: int = 0
     link_down_s: float = 0.0  # total time the link has been lost so far
@@ -128,12 +131,30 @@ class LinkLike(Protocol):
     def send_arm(self, force: bool = False) -> bool: ...
     def send_disarm(self, force: bool = False) -> bool: ...
     def send_set_mode(self, mode: FlightMode | int) -> bool: ...
+    def set_gcs_heartbeat(self, enabled: bool) -> None: ...
 
     @property
     def lost(self) -> bool: ...
 
     @property
-    def stats(self) -> Any: ...
+    def stats(self) -> LinkStats: ...
+
+    @property
+    def dialect(self) -> Dialect: ...
+
+
+@runtime_checkable
+class ScaledTime(Protocol):
+    """A clock that runs faster than real time (`gcs.clock.ScaledClock`, for a sped-up SITL)."""
+
+    @property
+    def speedup(self) -> float: ...
+
+
+def clock_speedup(clock: Clock) -> float:
+    """How many times faster than real time `clock` runs: what a dead loop, which can only
+    pace itself on real time, divides its waits by (1 for every clock but a scaled one)."""
+    return clock.speedup if isinstance(clock, ScaledTime) else 1.0
 
 
 def control_mode(state: SupervisorState, position: bool) -> ControlMode:
