@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from typing import Any
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
 
 from logs import SceneBox, foxglove_pose, foxglove_scene_from_boxes, foxglove_transform
 from logs.foxglove import foxglove_scene, scene_entity, scene_line_strip, scene_sphere
@@ -54,10 +55,24 @@ def xyz(p: Sequence[float]) -> dict[str, float]:
     return {"x": float(p[0]), "y": float(p[1]), "z": float(p[2])}
 
 
+class TopicSink(Protocol):
+    """Where mission topics go: a `logs.Recorder`, a station's `FoxgloveFeed`, a live view."""
+
+    def put(self, topic: str, t_s: float, payload: Any) -> None: ...
+
+
+@runtime_checkable
+class FileSink(TopicSink, Protocol):
+    """A sink that writes a file (a live view alone writes none)."""
+
+    @property
+    def path(self) -> Path | None: ...
+
+
 class MissionRecording:
     """Writes mission topics to a `logs.Recorder` (or nowhere when it is None)."""
 
-    def __init__(self, recorder: Any | None) -> None:
+    def __init__(self, recorder: TopicSink | None) -> None:
         self.recorder = recorder
         self._paths: dict[int, list[tuple[float, float, float]]] = {}
         self._next_path_s = -math.inf
@@ -66,7 +81,7 @@ class MissionRecording:
     @property
     def path(self) -> str | None:
         """The MCAP file, if recording."""
-        path = getattr(self.recorder, "path", None)
+        path = self.recorder.path if isinstance(self.recorder, FileSink) else None
         return str(path) if path is not None else None
 
     def put(self, topic: str, t_s: float, payload: Any) -> None:

@@ -23,7 +23,6 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any
 
 from firmware_link.records import (
     CommandAck,
@@ -52,6 +51,7 @@ from gcs.station.types import (
     EventLevel,
     LinkLike,
     LoopSample,
+    MocapSource,
     Recorder,
     StationEvent,
     StationSetup,
@@ -92,7 +92,7 @@ class Station(StationIntents):
         config: StationConfig | None = None,
         curve: ThrottleCurve | None = None,
         hover_throttle: float | None = None,
-        mocap: Any = None,
+        mocap: MocapSource | None = None,
         recorder: Recorder | None = None,
         clock: Clock | None = None,
         supervisor: SupervisorParams | None = None,

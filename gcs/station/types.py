@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
@@ -120,6 +121,12 @@ class Recorder(Protocol):
     def put(self, topic: str, t_s: float, payload: Any) -> None: ...
 
     def put_raw(self, direction: str, t_s: float, data: bytes) -> None: ...
+
+
+class MocapSource(Protocol):
+    """Motion capture as the station reads it: the poses that arrived since the last poll."""
+
+    def poll(self) -> Sequence[TelemetryRecord]: ...
 
 
 class LinkLike(Protocol):
