@@ -18,10 +18,12 @@ the firmware's last reason.
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Callable
 from typing import Any
 
 from firmware_link.errors import LinkError, LinkUsageError
+from firmware_link.frames import FrameEndpoint
 from firmware_link.pwm import clamp_pwm_us
 from firmware_link.records import CommandAck, Dialect, FlightMode, RcCommand, StatusText
 
@@ -60,12 +62,12 @@ def one_line(text: str) -> str:
 class ArmingAndModes:
     """RC overrides, arming and modes; mixed into `VehicleLink` (LinkCore supplies the link)."""
 
-    _ep: Any
+    _ep: FrameEndpoint
     _clock: Callable[[], float]
     _last_stick_s: float
     _target_system: int
     _target_component: int
-    _statustexts: Any
+    _statustexts: deque[StatusText]
     _hb_count: int
     _armed: bool
     _mode: int

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
 
 from firmware_link.errors import LinkUsageError
 from firmware_link.firmware import FirmwareInfo
+from firmware_link.frames import FrameEndpoint
 from firmware_link.records import Dialect, LinkEventKind
 from firmware_link.streams import (
     BringUpReport,
@@ -33,7 +33,7 @@ PLAN_UTILISATION = 0.8  # share of a serial link the telemetry may fill; the res
 class StreamBringUp:
     """Stream planning and bring-up; mixed into `VehicleLink` (LinkCore supplies the link)."""
 
-    _ep: Any
+    _ep: FrameEndpoint
     _clock: Callable[[], float]
     _signing: bool
     _last_plan: StreamPlan | None

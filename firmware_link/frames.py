@@ -15,9 +15,12 @@ import hashlib
 from collections.abc import Callable
 from typing import Any
 
+from pymavlink.dialects.v10 import ardupilotmega as mavlink1
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
 from firmware_link.byte_transport import ByteTransport, TransportClosed
 from firmware_link.frame_reader import FrameReader
-from firmware_link.protocol import WireVersion, frame_overhead_bytes, mavlink, mavlink1
+from firmware_link.protocol import WireVersion, frame_overhead_bytes
 from firmware_link.stats import LinkStats, StatsTally
 from firmware_link.tx_queue import TxQueue
 
@@ -35,7 +38,8 @@ class _NoFile:
         """Never used: the endpoint packs and writes frames itself."""
 
 
-class _Parser(mavlink.MAVLink):
+# pymavlink ships no type information, so its parser class is Any to the type checker.
+class _Parser(mavlink.MAVLink):  # type: ignore[misc]
     """pymavlink's parser, checking a frame's signature before trusting its timestamp.
 
     pymavlink records a stream's timestamp before it compares signatures, so one forged frame

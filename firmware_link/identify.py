@@ -30,6 +30,7 @@ from firmware_link.firmware import (
     FirmwareInfo,
     decide_firmware,
 )
+from firmware_link.frames import FrameEndpoint
 from firmware_link.records import CommandAck, LinkEventKind, ParamValue
 
 MAV_CMD_REQUEST_MESSAGE = 512
@@ -44,7 +45,7 @@ BANNER_AFTER_LIST_S = 0.25  # after the first listed parameter, the banner is no
 class Identification:
     """`identify()` and `firmware`; mixed into `VehicleLink` (LinkCore supplies the link)."""
 
-    _ep: Any
+    _ep: FrameEndpoint
     _clock: Callable[[], float]
     _target_system: int
     _target_component: int

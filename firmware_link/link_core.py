@@ -34,6 +34,7 @@ from firmware_link.records import (
 )
 from firmware_link.stats import LinkStats
 from firmware_link.streams import DataStream, StreamPlan
+from firmware_link.transport import UdpPeer
 from firmware_link.upkeep import TransportUpkeep
 
 MAV_TYPE_GCS = 6
@@ -162,7 +163,7 @@ class LinkCore(TransportUpkeep):
         """A snapshot of the counters."""
         return self._ep.snapshot(self._clock())
 
-    def handoff(self) -> tuple[int, int, tuple | None] | None:
+    def handoff(self) -> tuple[int, int, UdpPeer | None] | None:
         """(transport generation, descriptor, UDP peer) of the open transport, for a process
         that must be able to take the link over (`gcs.station.guardian`); None while there is none
         (being reopened). A new generation is a new transport, whatever its descriptor."""

@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import math
 import struct
+from collections import deque
 from collections.abc import Callable, Iterable
 from typing import Any
 
 from firmware_link.errors import LinkError, LinkUsageError
+from firmware_link.frames import FrameEndpoint
 from firmware_link.records import ParamValue, StatusText
 
 MAV_PARAM_TYPE_REAL32 = 9
@@ -92,12 +94,12 @@ def _names_text(names: list[str]) -> str:
 class ParamProtocol:
     """Parameter exchanges; mixed into `VehicleLink` (LinkCore supplies the link)."""
 
-    _ep: Any
+    _ep: FrameEndpoint
     _clock: Callable[[], float]
     _target_system: int
     _target_component: int
     _param_types: dict[str, int]
-    _statustexts: Any
+    _statustexts: deque[StatusText]
     _send: Callable[[Any], bool]
     _step: Callable[[float], list[Any]]
 

@@ -39,7 +39,8 @@ def frame_overhead_bytes(wire: WireVersion, signed: bool = False) -> int:
 def message_class(name: str, wire: WireVersion = WireVersion.V2) -> type[Any]:
     """The generated pymavlink class of message `name` (e.g. "ATTITUDE")."""
     module = mavlink1 if wire is WireVersion.V1 else mavlink
-    for cls in module.mavlink_map.values():
+    classes: dict[int, type[Any]] = module.mavlink_map
+    for cls in classes.values():
         if cls.msgname == name:
             return cls
     raise KeyError(f"no MAVLink message named {name!r}")

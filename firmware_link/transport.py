@@ -159,10 +159,14 @@ class TcpTransport(_Descriptor):
         self._sock.close()
 
 
+# A UDP socket address: (host, port) over IPv4, (host, port, flowinfo, scope_id) over IPv6.
+UdpPeer = tuple[object, ...]
+
+
 class UdpTransport(_Descriptor):
     """UDP: `udpin` listens and answers whoever spoke last; `udpout` sends to a fixed peer."""
 
-    def __init__(self, spec: ConnectionSpec, sock: socket.socket, peer: tuple | None) -> None:
+    def __init__(self, spec: ConnectionSpec, sock: socket.socket, peer: UdpPeer | None) -> None:
         self.spec = spec
         self._sock = sock
         self._peer = peer
@@ -218,7 +222,7 @@ class UdpTransport(_Descriptor):
         return len(data)
 
     @property
-    def peer(self) -> tuple | None:
+    def peer(self) -> UdpPeer | None:
         """Where datagrams go: udpout's fixed address, udpin's last speaker (None before)."""
         return self._peer
 
@@ -362,7 +366,7 @@ class FdTransport(_SerialLine):
             self._fd = -1
 
 
-def adopt_transport(spec: ConnectionSpec, fd: int, peer: tuple | None) -> ByteTransport:
+def adopt_transport(spec: ConnectionSpec, fd: int, peer: UdpPeer | None) -> ByteTransport:
     """A transport around `fd`, a descriptor of an open link of `spec`'s kind handed over by
     another process (`peer`: where a UDP link sends). Takes ownership of `fd`."""
     if spec.transport is Transport.TCP:

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import socket
 from collections.abc import Callable
-from typing import Any
 
 from firmware_link.byte_transport import ByteTransport
 from firmware_link.connection import ConnectionSpec, Transport
 from firmware_link.errors import LinkError
+from firmware_link.frames import FrameEndpoint
 from firmware_link.records import LinkEventKind
 from firmware_link.transport import SerialTransport, TcpTransport
 
@@ -23,7 +23,7 @@ class TransportUpkeep:
     """Reconnect with backoff; mixed into `LinkCore`, which supplies the attributes below."""
 
     spec: ConnectionSpec
-    _ep: Any  # FrameEndpoint
+    _ep: FrameEndpoint
     _closed: bool
     _clock: Callable[[], float]
     reconnect_backoff_s: tuple[float, ...]

@@ -71,7 +71,7 @@ def main(argv: Sequence[str] | None = None, extra: Sequence[str] = ()) -> int:
         return exc.exit_code
     except LinkError as exc:
         print(f"quadgcs {args.command}: {exc}", file=sys.stderr)
-        return int(getattr(exc, "exit_code", 1))
+        return exc.exit_code
     except BrokenPipeError:
         # the reader (e.g. `| head`) went away: not an error, and nothing more to say
         devnull = os.open(os.devnull, os.O_WRONLY)

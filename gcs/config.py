@@ -20,7 +20,7 @@ import math
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from firmware_link.records import Dialect
 from gcs.control.altitude_controller import AltitudeControllerParams
@@ -28,6 +28,11 @@ from gcs.control.position_controller import PositionControllerParams
 from gcs.errors import UsageError
 from gcs.estimation import EstimatorParams
 from gcs.toml_file import read_toml
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+_D = TypeVar("_D", bound="DataclassInstance")
 
 
 class EstimatorKind(enum.Enum):
@@ -79,7 +84,7 @@ class StationConfig:
             raise ValueError("gil_switch_interval_s must be in (0, 0.1]")
 
 
-def _build(base: Any, data: dict[str, Any], where: str) -> Any:
+def _build(base: _D, data: dict[str, Any], where: str) -> _D:
     """`base` (a dataclass instance) with the fields in `data` replaced, checked and converted."""
     cls = type(base)
     hints = typing.get_type_hints(cls)

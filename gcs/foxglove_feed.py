@@ -25,11 +25,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from firmware_link.records import Attitude, MocapPose
 from gcs import topics
 from gcs.errors import RuntimeFault, UsageError
+from gcs.estimation import AltEstimate
 from gcs.supervisor import Intent, IntentKind
 from logs.errors import RecordingError
 from logs.foxglove import (
@@ -45,6 +46,10 @@ from logs.foxglove import (
 )
 from logs.topics import LOG_TOPIC, TF_TOPIC
 from worldfile import WorldFileError, load_world_file
+
+if TYPE_CHECKING:  # the recorder and the live view are opened only when asked for
+    from logs.live import LiveView
+    from logs.recorder import Recorder
 
 POSE_ESTIMATE = "/gcs/pose/estimate"
 POSE_MOCAP = "/gcs/pose/mocap"
@@ -67,7 +72,7 @@ def _log_level(level: Any) -> LogLevel:
         return LogLevel.UNKNOWN
 
 
-def open_live(address: str) -> Any:
+def open_live(address: str) -> LiveView:
     """A started `logs.live.LiveView` on `[HOST:]PORT`; one line when it cannot be."""
     from logs.live import LiveView, parse_address
 
@@ -105,7 +110,7 @@ def quat_from_euler(roll_rad: float, pitch_rad: float, yaw_rad: float) -> tuple[
 class FoxgloveFeed:
     """The station's recorder, plus the 3D panel's topics (see the module docstring)."""
 
-    def __init__(self, recorder: Any | None, live: Any | None = None, *, sysid: int = 1,
+    def __init__(self, recorder: Recorder | None, live: LiveView | None = None, *, sysid: int = 1,
                  boxes: Sequence[SceneBox] = (), rate_hz: float = DEFAULT_RATE_HZ,
                  live_prefix: str = "") -> None:
         if not rate_hz > 0:
@@ -168,7 +173,7 @@ class FoxgloveFeed:
         if self._live_direct is not None:
             self._live_direct.put_raw(direction, t_s, data)
 
-    def event(self, t_s: float, level: Any, text: str) -> None:
+    def event(self, t_s: float, level: LogLevel | int, text: str) -> None:
         """Forward a human-readable event ("/log")."""
         if self.recorder is not None:
             self.recorder.event(t_s, level, text)
@@ -213,7 +218,7 @@ class FoxgloveFeed:
         m = self._mocap
         return (m.pos_n[0], m.pos_n[1]) if m is not None else (0.0, 0.0)
 
-    def _on_estimate(self, t_s: float, est: Any) -> None:
+    def _on_estimate(self, t_s: float, est: AltEstimate) -> None:
         if t_s >= self._next_world_s:
             self._next_world_s = t_s + WORLD_EVERY_S
             self._out(TF_TOPIC, t_s, ned_display_transform())
@@ -221,7 +226,7 @@ class FoxgloveFeed:
                 self._out(SCENE_WORLD, t_s, self._world)
         if t_s >= self._next_estimate_s:
             self._next_estimate_s = self._next(self._next_estimate_s, t_s)
-            alt_m = float(getattr(est, "alt_m", math.nan))
+            alt_m = est.alt_m
             if math.isfinite(alt_m):
                 att = self._attitude
                 q = (quat_from_euler(att.roll_rad, att.pitch_rad, att.yaw_rad)

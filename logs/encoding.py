@@ -110,10 +110,12 @@ def _converter(cls: type) -> Callable[[Any], dict[str, Any]]:
                         if _fixed_float_tuple_len(hint))
         plain = tuple((k, name, hint) for k, name, hint, _ in fields
                       if not _fixed_float_tuple_len(hint))
-        get = (attrgetter(*names) if len(names) > 1
-               else lambda o: tuple(getattr(o, name) for name in names))
-        plain_get = (itemgetter(*(k for k, _, _ in plain)) if len(plain) > 1
-                     else (lambda v: tuple(v[k] for k, _, _ in plain)))
+        get: Callable[[object], tuple[Any, ...]] = (
+            attrgetter(*names) if len(names) > 1
+            else lambda o: tuple(getattr(o, name) for name in names))
+        plain_get: Callable[[tuple[Any, ...]], tuple[Any, ...]] = (
+            itemgetter(*(k for k, _, _ in plain)) if len(plain) > 1
+            else (lambda v: tuple(v[k] for k, _, _ in plain)))
 
         def conv(obj: Any) -> dict[str, Any]:
             values = get(obj)

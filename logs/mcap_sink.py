@@ -167,7 +167,7 @@ class McapSink:
 
     def flush(self) -> None:
         """End the open chunk and push everything written so far to the OS."""
-        self._writer.flush()
+        self._writer.flush()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
 
     def close(self) -> None:
         """Write the summary and index, then close the file."""
@@ -175,6 +175,6 @@ class McapSink:
             return
         self._closed = True
         try:
-            self._writer.finish()
+            self._writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
         finally:
             self._file.close()

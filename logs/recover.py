@@ -85,7 +85,7 @@ def recover(
                 first_ns = record.log_time if count == 0 else min(first_ns, record.log_time)
                 last_ns = max(last_ns, record.log_time)
                 count += 1
-        writer.finish()
+        writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
     except OSError as exc:
         raise RecordingError(f"{dst_path}: cannot write: {exc.strerror or exc}") from exc
     finally:

@@ -23,9 +23,14 @@ import types
 import typing
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 GRAVITY_MPS2 = 9.80665
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+_D = TypeVar("_D", bound="DataclassInstance")
 
 
 class ParamError(ValueError):
@@ -86,7 +91,7 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
     return value
 
 
-def build_dataclass(cls: type, data: Mapping[str, Any], where: str = "") -> Any:
+def build_dataclass(cls: type[_D], data: Mapping[str, Any], where: str = "") -> _D:
     """Build frozen dataclass `cls` from a TOML table: unknown keys and bad types are errors.
 
     Missing keys keep their defaults. Errors read `<where>.<field>: <problem>`.

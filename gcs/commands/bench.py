@@ -23,7 +23,7 @@ def available() -> list[str]:
     return sorted(p.stem for p in BENCH_DIR.glob("*.py") if not p.name.startswith("_"))
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `bench` subcommand."""
     p = sub.add_parser("bench", help="run measurement programs from bench/ (prints numbers)",
                        description=__doc__)

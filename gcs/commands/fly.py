@@ -19,7 +19,7 @@ import math
 import signal
 import socket
 import sys
-from typing import Any
+from typing import Any, Protocol, runtime_checkable
 
 from firmware_link import LinkError, parse_connection_string
 from firmware_link.records import Dialect
@@ -31,7 +31,14 @@ from gcs.station.session import StationSession
 from gcs.station.station import StationSnapshot
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+@runtime_checkable
+class Stepped(Protocol):
+    """A session whose simulated time moves only when it is ticked (a lockstep session)."""
+
+    def tick(self) -> None: ...
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `fly` subcommand."""
     p = sub.add_parser("fly", help="hold an altitude under the PC controller, then land",
                        description=__doc__)
@@ -222,7 +229,7 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
     here); the summary dict, or FlightFailed. `pilot_signals`: the terminal's SIGTERM and
     SIGQUIT land and kill this flight (a campaign's worker leaves its process's own)."""
     v = session.first
-    lockstep = hasattr(session, "tick")
+    lockstep = isinstance(session, Stepped)
     with contextlib.suppress(ValueError):  # not the main thread (tests): no handlers
         if pilot_signals:
             signal.signal(signal.SIGTERM, _on_sigterm)
@@ -231,7 +238,8 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
         v.station.start()
     printer = LivePrinter(session.clock) if live else None
     runner = FlightRunner(v.station, plan, printer,
-                          idle=getattr(session, "tick", None), sysid=v.sysid)
+                          idle=session.tick if isinstance(session, Stepped) else None,
+                          sysid=v.sysid)
     path = str(v.recorder.path) if v.recorder is not None else None
     try:
         runner.fly()
@@ -242,9 +250,8 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
     d = _summary_dict(runner.summary(v.truth_series()), path, v.link.dialect)
     d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
     d["status"] = "ok"
-    forwarder = getattr(session, "forwarder", None)
-    if forwarder is not None:
-        d["forward"] = dataclasses.asdict(forwarder.stats)
+    if session.forwarder is not None:
+        d["forward"] = dataclasses.asdict(session.forwarder.stats)
     rms = d.get("rms_error_m")
     if not isinstance(rms, float) or not math.isfinite(rms) or rms > ABSURD_RMS_M:
         raise FlightFailed(f"hold error {rms} m is not a flight that went as commanded "

@@ -17,7 +17,7 @@ from logs.recover import recover
 from logs.tlog import export_tlog, import_tlog
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add `logs` and its subcommands."""
     parser = subparsers.add_parser(
         "logs", help="inspect, export, recover and plot flight recordings (MCAP)"

@@ -15,11 +15,12 @@ from pathlib import Path
 
 from gcs.commands._vehicle_args import add_forward_argument, add_foxglove_argument
 from gcs.errors import MissionFailed, UsageError
-from gcs.mission.runner import RunOptions, run_mission
+from gcs.mission.options import RunOptions
+from gcs.mission.runner import run_mission
 from gcs.mission.spec import load_mission
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `mission` subcommand (with `run`)."""
     p = sub.add_parser("mission", help="run a mission file (EPBHA, flocking, radiation)",
                        description=__doc__)

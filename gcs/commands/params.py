@@ -68,7 +68,7 @@ def _add_vehicle_flags(p: argparse.ArgumentParser, *, on_action: bool) -> None:
                    help="MAVLink 2 signing key file (ArduCopter 4.x)")
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `params` subcommand and its actions."""
     p = sub.add_parser("params", help="show, get, set, save, load or diff vehicle parameters",
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

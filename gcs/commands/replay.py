@@ -18,7 +18,7 @@ from logs import RecordingError, open_recording
 from logs.replay import Player, ReplayMessage, run_headless
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add `replay`."""
     parser = subparsers.add_parser(
         "replay", help="play a recorded flight on the teleop screens (or headless)")

@@ -10,7 +10,6 @@ import argparse
 import signal
 import subprocess
 import sys
-from typing import Any
 
 FORWARDED: tuple[tuple[str, str], ...] = (
     ("world", "--world"),
@@ -27,7 +26,7 @@ FORWARDED: tuple[tuple[str, str], ...] = (
 )
 
 
-def register(subparsers: Any) -> None:
+def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `sitl` subcommand."""
     p: argparse.ArgumentParser = subparsers.add_parser(
         "sitl", help="run the bundled simulated vehicle(s) behind MAVLink endpoints"

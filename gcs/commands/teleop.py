@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 MAX_GAMEPAD_RATE_HZ = 250.0
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `teleop` subcommand."""
     p = sub.add_parser("teleop", help="fly one vehicle from the terminal (TUI)",
                        description=__doc__)

@@ -53,7 +53,8 @@ def init_sdl() -> ModuleType:
         raise RuntimeFault(f"gamepad: SDL did not start: {_error(sdl2)}")
     sdl2.SDL_JoystickEventState(sdl2.SDL_IGNORE)
     sdl2.SDL_GameControllerEventState(sdl2.SDL_IGNORE)
-    return sdl2
+    module: ModuleType = sdl2  # pysdl2 ships no types: an untyped module to the checker
+    return module
 
 
 def quit_sdl(sdl2: ModuleType) -> None:
@@ -198,11 +199,12 @@ class SdlPad:
     def _axis(self, role: str) -> float:
         src = self.mapping.axes[role]
         if src.name is not None:
-            raw = self._sdl.SDL_GameControllerGetAxis(self._gc, self._sdl_axis[role])
+            raw: int = self._sdl.SDL_GameControllerGetAxis(self._gc, self._sdl_axis[role])
             # SDL reads triggers 0..32767; -1 released .. +1 pressed matches a raw trigger axis
             value = 2.0 * raw / AXIS_FULL - 1.0 if src.name in TRIGGERS else raw / AXIS_FULL
         else:
-            value = self._sdl.SDL_JoystickGetAxis(self._js, src.index) / AXIS_FULL
+            axis: int = self._sdl.SDL_JoystickGetAxis(self._js, src.index)
+            value = axis / AXIS_FULL
         value = max(-1.0, min(1.0, value))
         return (-value if src.invert else value) + 0.0  # + 0.0: no "-0.00" on screen
 

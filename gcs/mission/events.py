@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Callable
-from typing import Any
+
+from gcs.mission.recording import TopicSink
 
 EVENT = "/mission/event"
 
@@ -33,7 +34,7 @@ class MissionEvent(enum.Enum):
 class EventLog:
     """Tells the pilot (a progress callback) and the recording (any `put(topic, t, payload)`)."""
 
-    def __init__(self, recording: Any | None, progress: Callable[[str], None] | None) -> None:
+    def __init__(self, recording: TopicSink | None, progress: Callable[[str], None] | None) -> None:
         """Events go to `recording` (None: nowhere) and as lines to `progress`."""
         self._rec = recording
         self._progress = progress

@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from gcs.errors import UsageError
@@ -27,7 +27,7 @@ from gcs.mission.options import RunOptions
 from gcs.mission.outcome import Outcome, mission_report
 from gcs.mission.planner_loop import fly_planner
 from gcs.mission.planner_params import PlannerSetup
-from gcs.mission.recording import SUMMARY, MissionRecording
+from gcs.mission.recording import SUMMARY, MissionRecording, TopicSink
 from gcs.mission.report import MissionReport, RunMode
 from gcs.mission.spec import MissionSpec
 from gcs.mission.team import Team
@@ -145,7 +145,7 @@ def _truth_books(crafts: dict[int, Craft], mw: MissionWorld) -> tuple[int, dict[
 class _MultiRecording(MissionRecording):
     """Mission topics into the first vehicle's recording; each vehicle's pose into its own."""
 
-    def __init__(self, recorders: dict[int, Any]) -> None:
+    def __init__(self, recorders: Mapping[int, TopicSink | None]) -> None:
         first = next(iter(recorders.values()))
         super().__init__(first)
         self.recorders = recorders

@@ -14,12 +14,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from logs import SceneBox, foxglove_pose, foxglove_scene_from_boxes, foxglove_transform
 from logs.foxglove import foxglove_scene, scene_entity, scene_line_strip, scene_sphere
-from planners.geometry import Box
+from planners.geometry import Box, Vec3
 from planners.proximity import Facing, ProximityReading
+
+if TYPE_CHECKING:  # the planners' result types; the loops that make them import the planners
+    from planners.epbha.types import Decision as EpbhaDecision
+    from planners.flocking.types import FlockStep
+    from planners.radiation.types import Decision as RadiationDecision
 
 SCENE = "/mission/scene"
 POSE = "/mission/pose"
@@ -54,10 +60,24 @@ def xyz(p: Sequence[float]) -> dict[str, float]:
     return {"x": float(p[0]), "y": float(p[1]), "z": float(p[2])}
 
 
+class TopicSink(Protocol):
+    """Where mission topics go: a `logs.Recorder`, a station's `FoxgloveFeed`, a live view."""
+
+    def put(self, topic: str, t_s: float, payload: Any) -> None: ...
+
+
+@runtime_checkable
+class FileSink(TopicSink, Protocol):
+    """A sink that writes a file (a live view alone writes none)."""
+
+    @property
+    def path(self) -> Path | None: ...
+
+
 class MissionRecording:
     """Writes mission topics to a `logs.Recorder` (or nowhere when it is None)."""
 
-    def __init__(self, recorder: Any | None) -> None:
+    def __init__(self, recorder: TopicSink | None) -> None:
         self.recorder = recorder
         self._paths: dict[int, list[tuple[float, float, float]]] = {}
         self._next_path_s = -math.inf
@@ -66,7 +86,7 @@ class MissionRecording:
     @property
     def path(self) -> str | None:
         """The MCAP file, if recording."""
-        path = getattr(self.recorder, "path", None)
+        path = self.recorder.path if isinstance(self.recorder, FileSink) else None
         return str(path) if path is not None else None
 
     def put(self, topic: str, t_s: float, payload: Any) -> None:
@@ -129,7 +149,8 @@ def step_setpoints(topic: str, payload: dict[str, Any],
     return {1: (payload["next_x"], payload["next_y"], z_n)}
 
 
-def epbha_payload(step: int, pos_n: Sequence[float], reading: ProximityReading, decision: Any,
+def epbha_payload(step: int, pos_n: Sequence[float], reading: ProximityReading,
+                  decision: EpbhaDecision,
                   cost_evaluations: int) -> dict[str, Any]:
     """One EPBHA step: readings, the cost table, the decision and the obstacle class."""
     return {
@@ -153,8 +174,8 @@ def epbha_payload(step: int, pos_n: Sequence[float], reading: ProximityReading, 
     }
 
 
-def flock_payload(step: int, positions_n: dict[int, Any], readings: dict[int, ProximityReading],
-                  out: Any) -> dict[str, Any]:
+def flock_payload(step: int, positions_n: dict[int, Vec3], readings: dict[int, ProximityReading],
+                  out: FlockStep) -> dict[str, Any]:
     """One flock step: every vehicle's position, reading, set position and mode."""
     return {
         "step": step,
@@ -178,7 +199,7 @@ def flock_payload(step: int, positions_n: dict[int, Any], readings: dict[int, Pr
 
 
 def radiation_payload(step: int, pos_n: Sequence[float], counts_per_s: float,
-                      decision: Any) -> dict[str, Any]:
+                      decision: RadiationDecision) -> dict[str, Any]:
     """One radiation sample and what the mapper asked for next."""
     return {
         "step": step,

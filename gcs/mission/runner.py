@@ -7,7 +7,7 @@ import dataclasses
 import sys
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
 
 from gcs.errors import UsageError
 from gcs.mission.executor import run_on_vehicles
@@ -21,6 +21,9 @@ from gcs.mission.report import MissionReport
 from gcs.mission.spec import MissionSpec, PlannerKind
 from gcs.mission.world import MissionWorld, load_world
 
+if TYPE_CHECKING:  # the recorder's module is imported only when a recording is asked for
+    from logs import Recorder
+
 
 def mission_world(spec: MissionSpec) -> MissionWorld:
     """The mission's world (required: the planners and the evaluation need it)."""
@@ -29,7 +32,7 @@ def mission_world(spec: MissionSpec) -> MissionWorld:
     return load_world(spec.world_path)
 
 
-def _open_recorder(spec: MissionSpec, options: RunOptions, mode: str) -> Any:
+def _open_recorder(spec: MissionSpec, options: RunOptions, mode: str) -> Recorder:
     from logs import Recorder, RecordingError
 
     meta = {"command": "mission", "mission": spec.name, "planner": spec.planner.value,

@@ -8,9 +8,8 @@ from gcs.supervisor import ActionKind, SupervisorOutput
 
 
 def send_decision(link: LinkLike, out: SupervisorOutput, heartbeats_on: bool) -> bool:
-    """Send `out`'s actions, turn the station's heartbeats on or off as it says (links without
-    the switch always send them) and send its override (none: silence is the decision). The
-    heartbeats' state now."""
+    """Send `out`'s actions, turn the station's heartbeats on or off as it says and send its
+    override (none: silence is the decision). The heartbeats' state now."""
     for a in out.actions:
         if a.kind is ActionKind.ARM:
             link.send_arm(False)
@@ -27,9 +26,7 @@ def send_decision(link: LinkLike, out: SupervisorOutput, heartbeats_on: bool) ->
             link.release_overrides()
     if out.heartbeat != heartbeats_on:
         heartbeats_on = out.heartbeat
-        set_hb = getattr(link, "set_gcs_heartbeat", None)
-        if set_hb is not None:
-            set_hb(out.heartbeat)
+        link.set_gcs_heartbeat(out.heartbeat)
     if out.command is not None:
         link.rc_override(out.command)
     return heartbeats_on

@@ -8,6 +8,7 @@ from collections.abc import Callable
 from typing import Any
 
 from firmware_link.records import FlightMode, Heartbeat, RcCommand
+from gcs.station.types import LinkLike
 from gcs.supervisor import SupervisorState
 
 EMERGENCY_LAND_S = 3.0
@@ -17,7 +18,7 @@ STICK_MIN_US = 1000
 LANDING_MODES = frozenset({FlightMode.LAND, FlightMode.RTL})
 
 
-def let_go(link: Any, state: SupervisorState, hb: Heartbeat | None) -> str:
+def let_go(link: LinkLike, state: SupervisorState, hb: Heartbeat | None) -> str:
     """Release the overrides if the vehicle is disarmed, in LAND, or the supervisor already let
     go; otherwise leave them (4.x would drop the throttle to the radio's minimum). The text to
     log, or '' when there is nothing to say."""
@@ -35,7 +36,7 @@ def let_go(link: Any, state: SupervisorState, hb: Heartbeat | None) -> str:
             "own failsafe takes over")
 
 
-def emergency_land(link: Any, throttle_us: int, period_s: float,
+def emergency_land(link: LinkLike, throttle_us: int, period_s: float,
                    seconds: float = EMERGENCY_LAND_S,
                    speedup: float = 1.0) -> Heartbeat | str | None:
     """SET_MODE LAND every half second with `throttle_us` (the supervisor's safe throttle:

@@ -36,14 +36,18 @@ import socket
 import subprocess
 import sys
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
-from firmware_link.connection import Transport
+from firmware_link.connection import ConnectionSpec, Transport
+from firmware_link.firmware import FirmwareInfo
 from firmware_link.records import Heartbeat
 from gcs.core.landing import lands_on_death
 from gcs.station.exit import emergency_land, let_go, stay_until_disarmed
 from gcs.station.types import StationSnapshot
 from gcs.supervisor import SupervisorState
+
+if TYPE_CHECKING:  # the guardian's process imports it where it opens its link
+    from firmware_link.vehicle_link import VehicleLink
 
 # A guardian just started is still importing pymavlink (1.0-1.3 s measured on a loaded 2-core
 # machine) before it reads the word to leave: waited 1 s, it was killed (exit -9) instead
@@ -57,8 +61,8 @@ HANDED_OVER = (Transport.TCP, Transport.UDPIN, Transport.UDPOUT, Transport.SERIA
 class GuardianSetup:
     """What the guardian needs to speak to the vehicle as the station did."""
 
-    spec: Any  # firmware_link.connection.ConnectionSpec
-    firmware: Any  # firmware_link.firmware.FirmwareInfo
+    spec: ConnectionSpec
+    firmware: FirmwareInfo
     target_system: int
     target_component: int
     signing_key: bytes | None
@@ -73,7 +77,8 @@ class GuardianGone(RuntimeError):
 class Guardian:
     """The station's side: start the process, keep it informed, stand it down."""
 
-    def __init__(self, link: Any, sock: socket.socket, proc: subprocess.Popen[bytes]) -> None:
+    def __init__(self, link: VehicleLink, sock: socket.socket,
+                 proc: subprocess.Popen[bytes]) -> None:
         self._link = link
         self._sock = sock
         self._proc = proc
@@ -83,7 +88,7 @@ class Guardian:
         self._gone = False
 
     @classmethod
-    def start(cls, link: Any, setup: GuardianSetup) -> Guardian | None:
+    def start(cls, link: VehicleLink, setup: GuardianSetup) -> Guardian | None:
         """A guardian for `link`, or None for a link no other process can take over (an
         in-memory lockstep link)."""
         if setup.spec.transport not in HANDED_OVER:

@@ -15,7 +15,7 @@ import functools
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from firmware_link import (
     Forwarder,
@@ -35,10 +35,15 @@ from gcs.foxglove_feed import DEFAULT_WORLD, FoxgloveFeed, open_live, world_boxe
 from gcs.parallel_open import open_in_parallel
 from gcs.preflight import PreflightReport, read_and_check
 from gcs.scoring import Series, station_time
-from gcs.sitl_process import SitlOptions, SitlProcess
+from gcs.sitl_process import SitlEndpoints, SitlOptions, SitlProcess
 from gcs.station.guardian import Guardian, GuardianSetup
 from gcs.station.station import Station
+from gcs.station.types import clock_speedup
 from gcs.toml_file import read_signing_key
+
+if TYPE_CHECKING:  # the recorder's module is imported only when a recording is asked for
+    from logs import Recorder
+    from logs.live import LiveView
 
 CURVE_PARAMS = {Dialect.APM25: ("THR_MIN", "THR_MID"), Dialect.COPTER4: ("MOT_THST_HOVER",)}
 STREAM_RATE_HZ = 40.0
@@ -101,9 +106,9 @@ class Vehicle:
     url: str
     link: VehicleLink
     station: Station
-    recorder: Any | None
+    recorder: Recorder | None
     # what the station records into: the recorder plus the 3D view's topics and the live view
-    sink: Any | None = None
+    sink: FoxgloveFeed | None = None
     # the bundled SITL's ground truth, for scoring only: nothing that flies reads it
     truth: TruthRecorder | None = None
 
@@ -135,9 +140,9 @@ class StationSession:
             else ScaledClock(options.speedup, options.spin_s)
         )
         self.vehicles: dict[int, Vehicle] = {}
-        self.sitl_endpoints: Any = None
+        self.sitl_endpoints: SitlEndpoints | None = None  # the bundled SITL's, when started
         self.preflight: dict[int, PreflightReport] = {}
-        self.live: Any = None  # logs.live.LiveView with --foxglove
+        self.live: LiveView | None = None  # with --foxglove
         self.forwarder: Forwarder | None = None
         self._stack = contextlib.ExitStack()
 
@@ -176,7 +181,7 @@ class StationSession:
         return report
 
     @staticmethod
-    def _vehicle_sticks(link: VehicleLink, config: Any) -> Any:
+    def _vehicle_sticks(link: VehicleLink, config: StationConfig) -> StationConfig:
         """The position loop's stick mapping as the vehicle has it (ANGLE_MAX, RC1/2_DZ)."""
         try:
             values = link.read_params(STICK_PARAMS)
@@ -227,14 +232,14 @@ class StationSession:
         self.vehicles.update(open_in_parallel(
             {sysid: functools.partial(self._open_vehicle, sysid, url, mocap_url, key, config)
              for sysid, url in urls.items()}, self._stack))
-        truth_url = getattr(self.sitl_endpoints, "truth", None)
+        truth_url = self.sitl_endpoints.truth if self.sitl_endpoints is not None else None
         if truth_url is not None:
             for sysid, v in self.vehicles.items():
                 v.truth = TruthRecorder(TruthLink.open(truth_url, clock=self.clock.now_s), sysid)
                 self._stack.callback(v.truth.close)
 
     def _open_vehicle(self, sysid: int, url: str, mocap_url: str | None, key: bytes | None,
-                      config: Any, stack: contextlib.ExitStack | None = None) -> Vehicle:
+                      config: StationConfig, stack: contextlib.ExitStack | None = None) -> Vehicle:
         """One vehicle (on its own thread, see `_open`): what it opens is undone through
         `stack` (default: the session's)."""
         stack = self._stack if stack is None else stack
@@ -287,7 +292,7 @@ class StationSession:
                           clock=self.clock)
         guardian = Guardian.start(link, GuardianSetup(
             link.spec, link.firmware, link.target_system, link.target_component, key,
-            config.period_s, getattr(self.clock, "speedup", 1.0)))
+            config.period_s, clock_speedup(self.clock)))
         if guardian is not None:
             station.add_listener(guardian.on_snapshot)
             # after the station's own landing and letting go, before the link closes: a

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, TypeVar
+from typing import TypeVar
 
 from firmware_link.records import (
     Attitude,
@@ -14,6 +14,7 @@ from firmware_link.records import (
     SimTruth,
     TelemetryRecord,
 )
+from firmware_link.stats import LinkStats
 from gcs.core.flight_core import FlightCore
 from gcs.station.intents import STICK_MIN_US
 from gcs.station.loop import LoopStats
@@ -29,7 +30,7 @@ def _newest(latest: Mapping[type, TelemetryRecord], cls: type[R]) -> R | None:
 
 
 def make_snapshot(t_s: float, k: int, *, running: bool, core: FlightCore,
-                  latest: dict[type, TelemetryRecord], loop: LoopStats, link_stats: Any,
+                  latest: dict[type, TelemetryRecord], loop: LoopStats, link_stats: LinkStats,
                   events: tuple[StationEvent, ...], listener_errors: int,
                   outcomes: tuple[Outcome, ...]) -> StationSnapshot:
     """The snapshot at tick `k` (-1 before the first); `latest` is the station's own, copied."""

@@ -23,11 +23,9 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any
 
 from firmware_link.records import (
     CommandAck,
-    Dialect,
     Heartbeat,
     LinkEvent,
     LinkEventKind,
@@ -53,10 +51,12 @@ from gcs.station.types import (
     EventLevel,
     LinkLike,
     LoopSample,
+    MocapSource,
     Recorder,
     StationEvent,
     StationSetup,
     StationSnapshot,
+    clock_speedup,
     control_mode,
 )
 from gcs.supervisor import (
@@ -92,7 +92,7 @@ class Station(StationIntents):
         config: StationConfig | None = None,
         curve: ThrottleCurve | None = None,
         hover_throttle: float | None = None,
-        mocap: Any = None,
+        mocap: MocapSource | None = None,
         recorder: Recorder | None = None,
         clock: Clock | None = None,
         supervisor: SupervisorParams | None = None,
@@ -103,9 +103,7 @@ class Station(StationIntents):
         self.recorder = recorder
         self.clock = clock or MonotonicClock()
         self.curve = curve or ThrottleCurve()
-        dialect = getattr(link, "dialect", Dialect.UNKNOWN)
-        self.supervisor_params = supervisor or SupervisorParams.for_dialect(
-            dialect if isinstance(dialect, Dialect) else Dialect.UNKNOWN)
+        self.supervisor_params = supervisor or SupervisorParams.for_dialect(link.dialect)
         self.core = FlightCore(self.config, self.curve, hover_throttle, self.supervisor_params)
         self.loop = FixedRateLoop(self.clock, self.config.period_s, self._tick,
                                   realtime_priority=self.config.realtime_priority)
@@ -268,7 +266,7 @@ class Station(StationIntents):
         if not self.core.lands_on_death:
             return
         hb = emergency_land(self.link, self._snapshot.safe_throttle_us,
-                            self.config.period_s, speedup=getattr(self.clock, "speedup", 1.0))
+                            self.config.period_s, speedup=clock_speedup(self.clock))
         if isinstance(hb, Heartbeat):
             self._latest[Heartbeat] = hb
         elif hb:

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import enum
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 from firmware_link.records import (
     Attitude,
+    Dialect,
     FlightMode,
     Heartbeat,
     Imu,
@@ -17,6 +19,8 @@ from firmware_link.records import (
     SimTruth,
     TelemetryRecord,
 )
+from firmware_link.stats import LinkStats
+from gcs.clock import Clock
 from gcs.control.altitude_controller import AltControlOutput
 from gcs.control.position_controller import PositionCommand, PositionSetpoint
 from gcs.estimation import AltEstimate
@@ -81,7 +85,7 @@ class StationSnapshot:
     throttle_gate_us: int | None
     hover_throttle: float
     loop: LoopStats
-    link_stats: Any
+    link_stats: LinkStats
     events: tuple[StationEvent, ...]
     listener_errors: int = 0
     link_down_s: float = 0.0  # total time the link has been lost so far
@@ -119,6 +123,12 @@ class Recorder(Protocol):
     def put_raw(self, direction: str, t_s: float, data: bytes) -> None: ...
 
 
+class MocapSource(Protocol):
+    """Motion capture as the station reads it: the poses that arrived since the last poll."""
+
+    def poll(self) -> Sequence[TelemetryRecord]: ...
+
+
 class LinkLike(Protocol):
     """The subset of firmware_link.VehicleLink the station uses."""
 
@@ -128,12 +138,30 @@ class LinkLike(Protocol):
     def send_arm(self, force: bool = False) -> bool: ...
     def send_disarm(self, force: bool = False) -> bool: ...
     def send_set_mode(self, mode: FlightMode | int) -> bool: ...
+    def set_gcs_heartbeat(self, enabled: bool) -> None: ...
 
     @property
     def lost(self) -> bool: ...
 
     @property
-    def stats(self) -> Any: ...
+    def stats(self) -> LinkStats: ...
+
+    @property
+    def dialect(self) -> Dialect: ...
+
+
+@runtime_checkable
+class ScaledTime(Protocol):
+    """A clock that runs faster than real time (`gcs.clock.ScaledClock`, for a sped-up SITL)."""
+
+    @property
+    def speedup(self) -> float: ...
+
+
+def clock_speedup(clock: Clock) -> float:
+    """How many times faster than real time `clock` runs: what a dead loop, which can only
+    pace itself on real time, divides its waits by (1 for every clock but a scaled one)."""
+    return clock.speedup if isinstance(clock, ScaledTime) else 1.0
 
 
 def control_mode(state: SupervisorState, position: bool) -> ControlMode:

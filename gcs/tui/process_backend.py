@@ -42,7 +42,7 @@ def _child(options: SessionOptions, conn: Connection) -> None:
             backend = StationBackend(
                 v.station, url=v.url,
                 recording=str(v.recorder.path) if v.recorder is not None else None,
-                dialect=v.link.dialect.value, signing=v.link.signing,
+                dialect=v.link.dialect.value, signing=v.link.signing, forward=v.link.forward,
             )
             v.station.start()
             conn.send(("ready", backend.view()))

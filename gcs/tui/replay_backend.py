@@ -137,7 +137,7 @@ class ReplayBackend:
         """Nothing to release: the recording is read-only."""
 
 
-def _down_m(vec: Any) -> float | None:
+def _down_m(vec: object) -> float | None:
     """The z (down) part of a recorded vector: {"x","y","z"} as written, or a 3-list."""
     z = vec.get("z") if isinstance(vec, dict) else (
         vec[2] if isinstance(vec, list | tuple) and len(vec) == 3 else None)

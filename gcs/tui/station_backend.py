@@ -11,7 +11,8 @@ import math
 import threading
 from collections import deque
 
-from firmware_link.records import FlightMode, Rangefinder, SystemStatus
+from firmware_link.forward import ForwardPort
+from firmware_link.records import Battery, FlightMode, Rangefinder, SystemStatus
 from gcs.estimation import DeadReckoningEstimator
 from gcs.pilot import intents
 from gcs.pilot.view import AltitudeView, LinkView, LoopView, TeleopView, VehicleView
@@ -31,12 +32,14 @@ class StationBackend:
     live = True
 
     def __init__(self, station: Station, *, url: str = "", recording: str | None = None,
-                 dialect: str = "", signing: bool = False) -> None:
+                 dialect: str = "", signing: bool = False,
+                 forward: ForwardPort | None = None) -> None:
         self.station = station
         self.url = url
         self.recording = recording
         self.dialect = dialect
         self.signing = signing
+        self.forward = forward  # the forwarded stations' side of the link (None: no --forward)
         n = int(HISTORY_S / (station.config.period_s * HISTORY_EVERY_TICKS))
         self._alt: deque[tuple[float, float | None, float | None, float | None]] = deque(maxlen=n)
         self._acc: deque[tuple[float, float | None]] = deque(maxlen=n)
@@ -88,12 +91,12 @@ class StationBackend:
             alt_hist, acc_hist = tuple(self._alt), tuple(self._acc)
         hb = snap.heartbeat
         stats = snap.link_stats
-        battery = next((r for t, r in snap.latest.items() if t.__name__ == "Battery"), None)
+        battery = snap.latest.get(Battery)
+        battery = battery if isinstance(battery, Battery) else None
         est, att = snap.estimate, snap.attitude
         sonar = snap.rangefinder
         loop = snap.loop
-        forward = getattr(self.station.link, "forward", None)
-        fwd = forward.stats if forward is not None else None
+        fwd = self.forward.stats if self.forward is not None else None
         return TeleopView(
             t_s=snap.t_s,
             link=LinkView(
@@ -102,9 +105,9 @@ class StationBackend:
                 connected=hb is not None,
                 lost=snap.link_lost,
                 heartbeat_age_s=snap.t_s - hb.t_s if hb is not None else None,
-                msgs_per_s=getattr(stats, "rx_messages_per_s", None),
-                rx_lost=getattr(stats, "lost_messages", 0),
-                rx_bad=getattr(stats, "bad_frames", 0) + getattr(stats, "signature_refusals", 0),
+                msgs_per_s=stats.rx_messages_per_s,
+                rx_lost=stats.lost_messages,
+                rx_bad=stats.bad_frames + stats.signature_refusals,
                 signing=self.signing,
                 recording=self.recording,
                 fwd_stations=fwd.stations if fwd is not None else None,
@@ -115,8 +118,8 @@ class StationBackend:
                 if snap.vehicle_mode >= 0 else "",
                 armed=snap.armed,
                 failsafe=hb is not None and hb.system_status >= SystemStatus.CRITICAL,
-                battery_v=getattr(battery, "voltage_v", None),
-                battery_pct=getattr(battery, "remaining_pct", None),
+                battery_v=battery.voltage_v if battery is not None else None,
+                battery_pct=battery.remaining_pct if battery is not None else None,
                 roll_deg=math.degrees(att.roll_rad) if att else None,
                 pitch_deg=math.degrees(att.pitch_rad) if att else None,
                 yaw_deg=math.degrees(att.yaw_rad) if att else None,

@@ -20,12 +20,14 @@ import operator
 from collections.abc import Callable
 from typing import Any
 
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
 from sitl.autopilot import Key, ParamError, Profile
 from sitl.companion import Companion
 from sitl.link import telemetry as tm
 from sitl.link import telemetry_full
 from sitl.link.channel import Channel
-from sitl.link.codec import mavlink, messages
+from sitl.link.codec import messages
 from sitl.link.view import VehicleView
 
 MAV_CMD_DO_SET_MODE = 176

@@ -46,7 +46,7 @@ def _payload_fn(cls: type) -> Payload | None:
             getters.append((f"_{name}_raw", 0))
         else:
             getters.append((name, n))
-    pack = unpacker.pack
+    pack: Callable[..., bytes] = unpacker.pack
     if all(n == 0 for _, n in getters):  # one value per field: fetched in C, in one call
         get = attrgetter(*(a for a, _ in getters))
         if len(getters) == 1:

@@ -55,4 +55,3 @@ class VehicleView:
     sonar_max_m: float = 4.0
     has_radiation: bool = False
     signing_key: bytes | None = None
-    channels: list = field(default_factory=list)  # the vehicle's Channel objects

@@ -23,12 +23,13 @@ _EXP = 5.25588
 
 def isa_pressure_pa(alt_amsl_m: float) -> float:
     """ISA static pressure at an altitude above mean sea level."""
-    return _P0_PA * (1.0 - _K * alt_amsl_m) ** _EXP
+    # float ** float is typed as possibly complex; the base is positive below 44 km
+    return float(_P0_PA * (1.0 - _K * alt_amsl_m) ** _EXP)
 
 
 def isa_altitude_m(pressure_pa: float) -> float:
     """ISA altitude above mean sea level of a static pressure."""
-    return (1.0 - (pressure_pa / _P0_PA) ** (1.0 / _EXP)) / _K
+    return float((1.0 - (pressure_pa / _P0_PA) ** (1.0 / _EXP)) / _K)
 
 
 @tick_record

@@ -21,6 +21,7 @@ from firmware_link.records import (
     SimTruth,
     SystemStatus,
 )
+from firmware_link.stats import LinkStats
 from gcs import topics
 from gcs.clock import MonotonicClock, SimClock
 from gcs.control.position_controller import PositionSetpoint
@@ -52,7 +53,8 @@ class FakeBoard:
         self.modes: list[int] = []
         self.mode = 0
         self.heartbeats_on: list[bool] = []
-        self.stats = {"rx_messages": 0}
+        self.stats = LinkStats()
+        self.dialect = Dialect.UNKNOWN  # no firmware told: the supervisor's neutral limits
         self._k = 0
         self.fail_poll = False
 
