@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from firmware_link.records import Dialect
 from gcs.control.altitude_controller import AltitudeControllerParams
 from gcs.control.position_controller import PositionControllerParams
 from gcs.errors import UsageError
@@ -131,33 +130,6 @@ def load_config(path: str | Path | None) -> StationConfig:
     p = Path(path)
     data = read_toml(p, label=str(p), noun="config file")
     return _build(StationConfig(), data, f"{p}: ")
-
-
-ANALOG_SONAR_STEP_M = 0.06
-"""ArduCopter 3.2.1 reads its analog sonar through the APM's 10-bit ADC in whole millivolts:
-its RANGEFINDER distances come in steps of about 6 cm (4, 10, 16, 23 ... cm in the 3.2.1
-fixture's 211 readings), not the whole centimetres 4.x sends."""
-
-
-def for_dialect(config: StationConfig, dialect: Dialect) -> StationConfig:
-    """The configuration with the vehicle's rangefinder resolution, unless the file chose one.
-
-    Judged at the whole-centimetre default, a 3.2.1's 6 cm steps look like jumps of six
-    standard deviations: the hold chases each one (8 cm RMS in lockstep against 0.9 cm with
-    whole centimetres). Taken as the reading's resolution they are a uniform error of ±3 cm,
-    and a value that stays put for longer is what such a sensor does in a steady hover.
-    """
-    est = config.estimator
-    if dialect is not Dialect.APM25 or est.sonar_resolution_m != DEFAULT_RESOLUTION_M:
-        return config
-    step = ANALOG_SONAR_STEP_M
-    return dataclasses.replace(config, estimator=dataclasses.replace(
-        est, sonar_resolution_m=step,
-        sonar_stale_move_m=step + 2.0 * est.sonar_sigma_m,
-        reacquire_track_rms_m=max(est.reacquire_track_rms_m, step / math.sqrt(12.0) + 0.02)))
-
-
-DEFAULT_RESOLUTION_M = EstimatorParams().sonar_resolution_m
 
 
 def config_from_table(data: dict[str, Any], where: str = "") -> StationConfig:

@@ -26,7 +26,7 @@ from firmware_link import (
 from firmware_link.records import Battery, Dialect, GpsFix, MocapPose
 from firmware_link.truth_link import TruthLink, TruthRecorder
 from gcs.clock import Clock, MonotonicClock, ScaledClock
-from gcs.config import StationConfig, for_dialect, load_config
+from gcs.config import StationConfig, load_config
 from gcs.control.position_controller import STICK_PARAMS, with_vehicle_sticks
 from gcs.control.throttle_curve import ThrottleCurve
 from gcs.errors import UsageError
@@ -280,7 +280,6 @@ class StationSession:
             raise ParamError(f"{exc} (the throttle curve needs {', '.join(exc.names)})",
                              exc.names) from None
         curve = ThrottleCurve.for_dialect(link.dialect, params)
-        config = for_dialect(config, link.dialect)
         if mocap_url is not None:
             config = self._vehicle_sticks(link, config)
         mocap = None
