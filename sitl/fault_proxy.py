@@ -26,7 +26,7 @@ call blocks its caller except `stop()` and `wait_until()`.
     FaultProxy(..., tap=fn)            # fn(direction, fate, frame, arrival) for every frame
     proxy.stop()
 
-`python -m sitl.fault_proxy --help` runs it from a shell (`sitl.fault_proxy_cli`).
+`python -m sitl.fault_proxy_cli --help` runs it from a shell.
 """
 
 from __future__ import annotations
@@ -447,10 +447,3 @@ class FaultProxy:
             with self._cond:
                 self._cond.notify_all()
 
-
-if __name__ == "__main__":
-    import sys
-
-    from sitl.fault_proxy_cli import main
-
-    sys.exit(main())
