@@ -10,6 +10,8 @@ from __future__ import annotations
 import enum
 from typing import Any
 
+from logs.errors import RecordingError
+
 
 class LogLevel(enum.IntEnum):
     """foxglove.Log levels."""
@@ -20,6 +22,18 @@ class LogLevel(enum.IntEnum):
     WARNING = 3
     ERROR = 4
     FATAL = 5
+
+
+def parse_log_level(level: LogLevel | int | str) -> LogLevel:
+    """A level from its member, number or name (`"warn"` too); else a RecordingError."""
+    try:
+        if isinstance(level, str):
+            name = level.strip().upper()
+            return LogLevel.WARNING if name == "WARN" else LogLevel[name]
+        return LogLevel(int(level))
+    except (KeyError, ValueError) as exc:
+        names = ", ".join(m.name.lower() for m in LogLevel)
+        raise RecordingError(f"log level {level!r}: expected one of {names}") from exc
 
 
 class NumericType(enum.IntEnum):
