@@ -2,6 +2,7 @@
 
 from logs.encoding import from_jsonable, to_jsonable, vector
 from logs.errors import RecordingError
+from logs.flight_file import Direction, files_metadata
 from logs.foxglove import (
     FoxgloveMessage,
     LogLevel,
@@ -14,7 +15,7 @@ from logs.foxglove import (
     foxglove_vehicle_transform,
 )
 from logs.reader import Recording, open_recording
-from logs.recorder import Direction, Recorder, RecorderStats, files_metadata
+from logs.recorder import Recorder, RecorderStats
 
 __all__ = [
     "Direction",

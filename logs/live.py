@@ -26,13 +26,13 @@ from typing import Any
 from logs.encoding import encode_json, schema_for_payload, to_jsonable
 from logs.errors import RecordingError
 from logs.foxglove import (
-    WELL_KNOWN_SCHEMAS,
     FoxgloveMessage,
     LogLevel,
     foxglove_log,
     ned_display_transform,
     stamped,
 )
+from logs.foxglove_schemas import WELL_KNOWN_SCHEMAS
 from logs.mcap_sink import schema_name_for_topic
 from logs.topics import LOG_TOPIC, MAVLINK_RX_TOPIC, MAVLINK_TX_TOPIC, TF_TOPIC
 

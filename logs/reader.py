@@ -20,7 +20,7 @@ from mcap.records import Channel, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
 from logs.errors import RecordingError
-from logs.recorder import METADATA_NAME
+from logs.flight_file import METADATA_NAME
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 TRUNCATED_HINT = "truncated: recover it with quadgcs logs recover"

@@ -22,7 +22,6 @@ import base64
 import dataclasses
 import datetime as dt
 import enum
-import json
 import threading
 import time
 from collections import deque
@@ -34,50 +33,36 @@ from typing import Any
 
 from logs.encoding import encode_json, schema_for_payload, to_jsonable
 from logs.errors import RecordingError
+from logs.flight_file import (
+    METADATA_NAME,
+    RAW_FRAME_SCHEMA,
+    RAW_FRAME_SCHEMA_NAME,
+    RAW_TOPIC_OF,
+    Direction,
+    encode_metadata,
+    resolve_path,
+    software_version,
+)
 from logs.foxglove import (
-    WELL_KNOWN_SCHEMAS,
     FoxgloveMessage,
     LogLevel,
     foxglove_log,
     ned_display_transform,
     stamped,
 )
+from logs.foxglove_schemas import WELL_KNOWN_SCHEMAS, parse_log_level
 from logs.mcap_sink import McapSink, schema_name_for_topic
-from logs.topics import LOG_TOPIC, MAVLINK_RX_TOPIC, MAVLINK_TX_TOPIC, TF_TOPIC
+from logs.topics import LOG_TOPIC, TF_TOPIC
 
 DEFAULT_DIR = Path("flights")
 YIELD_AFTER_S = 0.0002  # writer time slice before it lets other threads run
 # A simulated-time producer writes its queue once this many records wait: few enough that they
 # die young (4096 made the garbage collector's passes cost more than batching saved).
 INLINE_BATCH = 512
-METADATA_NAME = "quadgcs.flight"
-RAW_FRAME_SCHEMA_NAME = "quadgcs.MavlinkFrame"
-RAW_FRAME_SCHEMA: dict[str, Any] = {
-    "type": "object",
-    "title": "MAVLink frame",
-    "description": "One raw MAVLink frame as it crossed the link, base64",
-    "properties": {
-        "data": {"type": "string", "contentEncoding": "base64"},
-        "len": {"type": "integer", "minimum": 0},
-    },
-}
 
 
 Tap = Callable[[str, str, Mapping[str, Any], int, bytes], None]
 """(topic, schema name, JSON Schema, log time ns, the message's JSON) of each message written."""
-
-
-class Direction(enum.Enum):
-    """Which way a raw MAVLink frame crossed the link."""
-
-    RX = "rx"
-    TX = "tx"
-
-
-RAW_TOPICS = {Direction.RX: MAVLINK_RX_TOPIC, Direction.TX: MAVLINK_TX_TOPIC}
-# by member or value, without an Enum call on every frame
-_RAW_TOPIC_OF: dict[Direction | str, str] = {
-    **{d: t for d, t in RAW_TOPICS.items()}, **{d.value: t for d, t in RAW_TOPICS.items()}}
 
 
 class _Kind(enum.Enum):
@@ -109,84 +94,6 @@ class RecorderStats:
         return sum(self.dropped.values())
 
 
-def flight_file_name(started_utc: dt.datetime, vehicle: str) -> str:
-    """`2026-11-22T10-31-05Z_vehicle1.mcap`: sortable, and safe on every file system."""
-    safe_vehicle = "".join(c if c.isalnum() or c in "-_" else "_" for c in vehicle) or "vehicle"
-    return f"{started_utc.strftime('%Y-%m-%dT%H-%M-%SZ')}_{safe_vehicle}.mcap"
-
-
-def _resolve_path(path_or_dir: str | Path, started_utc: dt.datetime, vehicle: str) -> Path:
-    target = Path(path_or_dir)
-    if target.suffix == ".mcap" and not target.is_dir():
-        parent = target.parent
-    else:
-        parent = target
-        target = target / flight_file_name(started_utc, vehicle)
-        base = target.stem
-        n = 1
-        while target.exists():
-            target = parent / f"{base}-{n}.mcap"
-            n += 1
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise RecordingError(f"{parent}: cannot create directory: {exc.strerror or exc}") from exc
-    return target
-
-
-def _software_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("quadgcs")
-    except PackageNotFoundError:
-        return "unknown"
-
-
-def encode_metadata(metadata: Mapping[str, Any]) -> dict[str, str]:
-    """MCAP metadata is string → string: non-strings become JSON, listed under `json_keys`."""
-    out: dict[str, str] = {}
-    json_keys = []
-    for key, value in metadata.items():
-        if isinstance(value, str):
-            out[str(key)] = value
-        else:
-            out[str(key)] = json.dumps(to_jsonable(value), separators=(",", ":"))
-            json_keys.append(str(key))
-    if json_keys:
-        out["json_keys"] = json.dumps(json_keys)
-    return out
-
-
-def files_metadata(**paths: str | Path | None) -> dict[str, str]:
-    """World/mission/config files for the metadata record: `world_path` and `world` (its text).
-
-    A missing or unreadable file is noted in place of its text rather than stopping a flight.
-    """
-    out: dict[str, str] = {}
-    for name, path in paths.items():
-        if path is None:
-            continue
-        p = Path(path)
-        out[f"{name}_path"] = str(p)
-        try:
-            out[name] = p.read_text(encoding="utf-8", errors="replace")
-        except OSError as exc:
-            out[name] = f"<unreadable: {exc.strerror or exc}>"
-    return out
-
-
-def _log_level(level: LogLevel | int | str) -> LogLevel:
-    try:
-        if isinstance(level, str):
-            name = level.strip().upper()
-            return LogLevel.WARNING if name == "WARN" else LogLevel[name]
-        return LogLevel(int(level))
-    except (KeyError, ValueError) as exc:
-        names = ", ".join(m.name.lower() for m in LogLevel)
-        raise RecordingError(f"log level {level!r}: expected one of {names}") from exc
-
-
 class Recorder:
     """Record one flight to an MCAP file (see the module docstring)."""
 
@@ -207,7 +114,7 @@ class Recorder:
         self._anchor_ns = wall_ns - time.monotonic_ns() if anchor_ns is None else int(anchor_ns)
         started = dt.datetime.fromtimestamp(wall_ns / 1e9, tz=dt.UTC)
         self.vehicle = vehicle
-        self._path = _resolve_path(path_or_dir, started, vehicle)
+        self._path = resolve_path(path_or_dir, started, vehicle)
         self._sink = McapSink(self._path)
         self._flush_interval_s = float(flush_interval_s)
         self._max_queue = int(max_queue)
@@ -228,7 +135,7 @@ class Recorder:
         self._error: str | None = None
         header = {
             "vehicle": vehicle,
-            "software_version": _software_version(),
+            "software_version": software_version(),
             "started_utc": started.isoformat().replace("+00:00", "Z"),
             "anchor_ns": str(self._anchor_ns),
             **dict(metadata),
@@ -288,7 +195,7 @@ class Recorder:
     def put_raw(self, direction: Direction | str, t_s: float, data: bytes) -> None:
         """Queue one raw MAVLink frame, "rx" (from the vehicle) or "tx" (to it)."""
         try:
-            topic = _RAW_TOPIC_OF.get(direction)
+            topic = RAW_TOPIC_OF.get(direction)
         except TypeError:  # unhashable
             topic = None
         if topic is None:
@@ -297,7 +204,7 @@ class Recorder:
 
     def event(self, t_s: float, level: LogLevel | int | str, text: str) -> None:
         """Queue a human-readable event as a foxglove.Log line on "/log"."""
-        self._enqueue(_Kind.EVENT, LOG_TOPIC, t_s, (_log_level(level), str(text)))
+        self._enqueue(_Kind.EVENT, LOG_TOPIC, t_s, (parse_log_level(level), str(text)))
 
     def add_metadata(self, name: str, data: Mapping[str, Any]) -> None:
         """Queue an extra metadata record (e.g. the parameter snapshot once it has arrived)."""

@@ -17,14 +17,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from logs.errors import RecordingError
-from logs.mcap_sink import McapSink
-from logs.reader import Recording
-from logs.recorder import (
+from logs.flight_file import (
     METADATA_NAME,
     RAW_FRAME_SCHEMA,
     RAW_FRAME_SCHEMA_NAME,
     encode_metadata,
 )
+from logs.mcap_sink import McapSink
+from logs.reader import Recording
 from logs.topics import MAVLINK_RX_TOPIC, MAVLINK_TX_TOPIC
 
 MAVLINK1_STX = 0xFE

@@ -9,7 +9,7 @@ _native.guard()
 from sitl.autopilot import AutopilotOptions, FlightMode, Profile
 from sitl.battery import BatteryState
 from sitl.params import ParamError, VehicleParams
-from sitl.physics import PhysicsState
+from sitl.physics_state import PhysicsState
 from sitl.sensor_params import SensorParams
 from sitl.sensors import (
     BaroSample,

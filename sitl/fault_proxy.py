@@ -26,7 +26,7 @@ call blocks its caller except `stop()` and `wait_until()`.
     FaultProxy(..., tap=fn)            # fn(direction, fate, frame, arrival) for every frame
     proxy.stop()
 
-`python -m sitl.fault_proxy --help` runs it from a shell (`sitl.fault_proxy_cli`).
+`python -m sitl.fault_proxy_cli --help` runs it from a shell.
 """
 
 from __future__ import annotations
@@ -40,7 +40,6 @@ import threading
 import time
 import tty
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import serial
@@ -60,6 +59,7 @@ from sitl.fault_lanes import (
     sock_reader,
     sock_writer,
 )
+from sitl.fault_schedule import FaultSchedule, FaultSettings
 
 MAX_WAIT_S = 0.05
 Tap = Callable[[Direction, str, bytes, float], None]
@@ -68,19 +68,7 @@ arrived), and the `time.monotonic()` of its arrival. Runs on the relay thread: k
 SERIAL_BITS_PER_BYTE = 10  # 8N1
 
 
-@dataclass
-class _Settings:
-    loss: float = 0.0
-    bitflip: float = 0.0
-    delay_s: float = 0.0
-
-
-def _probability(name: str, p: float | None) -> None:
-    if p is not None and not 0.0 <= p <= 1.0:
-        raise ValueError(f"{name} must be a probability in 0..1, got {p}")
-
-
-class FaultProxy:
+class FaultProxy(FaultSchedule):
     """The injector: `FaultProxy(target=(host, port))` relays TCP, `FaultProxy(serial_port=
     path)` bridges a pseudo-terminal. After `start()`, a station connects to `address`."""
 
@@ -102,7 +90,7 @@ class FaultProxy:
         # one generator per direction: how much one way carries never changes the other's luck
         self._rng = {Direction.UP: np.random.default_rng(up_seq),
                      Direction.DOWN: np.random.default_rng(down_seq)}
-        self._settings = {Direction.UP: _Settings(), Direction.DOWN: _Settings()}
+        self._settings = {Direction.UP: FaultSettings(), Direction.DOWN: FaultSettings()}
         self._windows: list[FaultWindow] = []
         self._station_t_s: float | None = None
         self._counts = {Direction.UP: Counters(), Direction.DOWN: Counters()}
@@ -211,90 +199,6 @@ class FaultProxy:
                 with contextlib.suppress(OSError):
                     os.close(fd)
         self._wake_r = self._wake_w = -1
-
-    # -------------------------------------------------------------- time and faults
-    def now_s(self) -> float:
-        """Proxy time: simulated seconds since start()."""
-        return (time.monotonic() - self._t0) * self.time_scale
-
-    def monotonic_at(self, t_s: float) -> float:
-        """The `time.monotonic()` reading at proxy time `t_s`."""
-        return self._t0 + t_s / self.time_scale
-
-    def set(self, direction: Direction | str, *, loss: float | None = None,
-            bitflip: float | None = None, delay_s: float | None = None) -> None:
-        """Standing faults from now on (None leaves a setting as it is)."""
-        _probability("loss", loss)
-        _probability("bitflip", bitflip)
-        if delay_s is not None and not delay_s >= 0.0:
-            raise ValueError(f"delay must be >= 0 s, got {delay_s}")
-        with self._cond:
-            for d in as_direction(direction).lanes():
-                s = self._settings[d]
-                s.loss = s.loss if loss is None else loss
-                s.bitflip = s.bitflip if bitflip is None else bitflip
-                s.delay_s = s.delay_s if delay_s is None else delay_s
-
-    def drop(self, direction: Direction | str, duration_s: float, start_s: float = 0.0, *,
-             from_station: bool = False) -> FaultWindow:
-        """Drop everything one way (or both) for `duration_s`, from `start_s` after now (or
-        after the first station arrives)."""
-        return self.schedule(direction, start_s, duration_s, drop=True,
-                             from_station=from_station)
-
-    def schedule(self, direction: Direction | str, start_s: float, duration_s: float, *,
-                 drop: bool = False, loss: float = 0.0, bitflip: float = 0.0,
-                 delay_s: float = 0.0, from_station: bool = False) -> FaultWindow:
-        """A fault window `start_s` after now, lasting `duration_s` (simulated seconds). With
-        `from_station` it counts from the first station's arrival (its TCP connection, or its
-        first byte on the pseudo-terminal), decided on the relay thread, so no frame of the
-        station's first moments slips past. Over the standing settings the stronger loss and
-        bit-flip rates and the longer delay act."""
-        _probability("loss", loss)
-        _probability("bitflip", bitflip)
-        if not (duration_s > 0.0 and start_s >= 0.0 and delay_s >= 0.0):
-            raise ValueError(f"a window needs start >= 0, duration > 0 and delay >= 0; got "
-                             f"start {start_s}, duration {duration_s}, delay {delay_s}")
-        t = start_s if from_station else self.now_s() + start_s
-        w = FaultWindow(as_direction(direction), t, t + duration_s, drop, loss, bitflip,
-                        delay_s, from_station)
-        with self._cond:
-            self._windows.append(w)
-        return w
-
-    @property
-    def station_arrived_s(self) -> float | None:
-        """Proxy time of the first station's arrival (None: not yet)."""
-        with self._cond:
-            return self._station_t_s
-
-    def clear(self) -> None:
-        """No faults from now on: windows and standing settings gone."""
-        with self._cond:
-            self._windows.clear()
-            self._settings = {d: _Settings() for d in self._settings}
-
-    def windows(self) -> list[FaultWindow]:
-        """Every window still on the books."""
-        with self._cond:
-            return list(self._windows)
-
-    def _effective(self, d: Direction, t_s: float) -> tuple[bool, _Settings]:
-        base = self._settings[d]
-        eff = _Settings(base.loss, base.bitflip, base.delay_s)
-        dropping = False
-        for w in self._windows:
-            t = t_s
-            if w.from_station:
-                if self._station_t_s is None:
-                    continue
-                t -= self._station_t_s
-            if d in w.direction.lanes() and w.start_s <= t < w.end_s:
-                dropping = dropping or w.drop
-                eff.loss = max(eff.loss, w.loss)
-                eff.bitflip = max(eff.bitflip, w.bitflip)
-                eff.delay_s = max(eff.delay_s, w.delay_s)
-        return dropping, eff
 
     # -------------------------------------------------------------- counters
     def counters(self, direction: Direction | str) -> Counters:
@@ -447,10 +351,3 @@ class FaultProxy:
             with self._cond:
                 self._cond.notify_all()
 
-
-if __name__ == "__main__":
-    import sys
-
-    from sitl.fault_proxy_cli import main
-
-    sys.exit(main())

@@ -1,4 +1,4 @@
-"""`python -m sitl.fault_proxy`: put a fault injector between a ground station and a vehicle.
+"""`python -m sitl.fault_proxy_cli`: put a fault injector between a ground station and a vehicle.
 
 Stdout contract (as the SITL's): `proxy tcp:127.0.0.1:<port>` or `proxy serial:<pty>`, then
 `ready`. Window starts count from the first station: its TCP connection, or its first byte on
@@ -117,8 +117,8 @@ def _positive(text: str) -> float:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """Parser of `python -m sitl.fault_proxy`."""
-    p = OneLineParser(prog="python -m sitl.fault_proxy", description=__doc__,
+    """Parser of `python -m sitl.fault_proxy_cli`."""
+    p = OneLineParser(prog="python -m sitl.fault_proxy_cli", description=__doc__,
                       formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--target", type=_target, required=True, metavar="URL",
                    help="the vehicle endpoint: tcp:HOST:PORT, or serial:/dev/pts/N (opened "
@@ -216,5 +216,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of `python -m sitl.fault_proxy`."""
+    """Entry point of `python -m sitl.fault_proxy_cli`."""
     return run(build_parser().parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -54,6 +54,7 @@ COMPILED = (
     "sitl/mocap_server.py",
     "sitl/motors.py",
     "sitl/physics.py",
+    "sitl/physics_state.py",
     "sitl/rotation.py",
     "sitl/simulation.py",
     "sitl/truth_server.py",

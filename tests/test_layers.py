@@ -10,8 +10,6 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parent.parent
 
 # package -> the project packages it may import (DESIGN.md's "may import" column)
@@ -31,7 +29,7 @@ PROJECT = frozenset(ALLOWED) | {"tests", "bench"}
 THIRD_PARTY = frozenset({
     "pymavlink", "serial", "numpy", "textual", "textual_plotext", "mcap", "contourpy",
     "shapely", "sdl2", "sdl2dll", "foxglove", "matplotlib", "ray", "optuna", "pyarrow",
-    "mypy_extensions",
+    "mypy_extensions", "rich", "fastcrc",
 })
 STDLIB = frozenset(sys.stdlib_module_names) | {"_typeshed", "typing_extensions", "__future__"}
 
@@ -219,20 +217,10 @@ def test_cycle_finder_finds_a_cycle_and_only_it() -> None:
     assert cycles(graph) == [["a", "b", "c"]]
 
 
-# Findings not yet fixed, each to go (#32); a new finding fails at once, a fixed one must leave
-# this list (the strict xfail below turns green only when both lists are empty).
-KNOWN_ARROWS: frozenset[str] = frozenset({
-    # an optional CRC accelerator with a pure fallback, pinned in constraints.txt only
-    "firmware_link/frame_reader.py:27: fastcrc.crc16.mcrf4xx is neither stdlib nor declared",
-    "sitl/link/packer.py:21: fastcrc.crc16.mcrf4xx is neither stdlib nor declared",
-    # textual's own dependency, imported directly
-    "gcs/tui/app.py:14: rich.text.Text is neither stdlib nor declared",
-    "gcs/tui/pad_panel.py:5: rich.text.Text is neither stdlib nor declared",
-    "gcs/tui/widgets.py:5: rich.text.Text is neither stdlib nor declared",
-})
-KNOWN_CYCLES: frozenset[tuple[str, ...]] = frozenset({
-    ("sitl.fault_proxy", "sitl.fault_proxy_cli"),
-})
+# Findings accepted for now (none today); a new finding fails at once, a fixed one must leave
+# these lists.
+KNOWN_ARROWS: frozenset[str] = frozenset()
+KNOWN_CYCLES: frozenset[tuple[str, ...]] = frozenset()
 
 
 def _lines(found: Iterable[object]) -> str:
@@ -254,7 +242,6 @@ def test_no_new_import_cycle() -> None:
     assert not gone, "fixed: remove from KNOWN_CYCLES:\n" + _lines(sorted(gone))
 
 
-@pytest.mark.xfail(strict=True, reason="#32: the KNOWN_ARROWS findings (undeclared imports)")
 def test_every_package_imports_only_what_the_design_allows() -> None:
     bad = arrow_violations()
     assert not bad, "imports against DESIGN.md's table:\n" + "\n".join(bad)
@@ -270,7 +257,6 @@ def test_the_station_never_reaches_the_sitl() -> None:
     assert not bad
 
 
-@pytest.mark.xfail(strict=True, reason="#32: KNOWN_CYCLES (sitl.fault_proxy's __main__)")
 def test_no_import_cycle() -> None:
     found = cycles(import_graph())
     assert not found, "import cycles:\n" + "\n".join(" <-> ".join(c) for c in found)
@@ -292,7 +278,6 @@ def package_graph(depth: int = 2) -> dict[str, set[str]]:
 
 
 KNOWN_PACKAGE_CYCLES: frozenset[tuple[str, ...]] = frozenset({
-    ("sitl.fault_proxy", "sitl.fault_proxy_cli"),  # a module cycle, in KNOWN_CYCLES too
     # sitl/link/ and the SITL's top-level modules import each other
     ("sitl.companion", "sitl.link", "sitl.mocap_server", "sitl.simulation", "sitl.truth_server"),
 })

@@ -16,7 +16,8 @@ from logs import (
     foxglove_scene_from_boxes,
     open_recording,
 )
-from logs.foxglove import Q_ENU_NED, WELL_KNOWN_SCHEMAS, grid_values
+from logs.foxglove import Q_ENU_NED, grid_values
+from logs.foxglove_schemas import WELL_KNOWN_SCHEMAS
 
 
 def _keys_match_schema(message: dict, schema: dict) -> None:

@@ -16,8 +16,9 @@ from mcap.reader import make_reader
 from gcs.foxglove_feed import POSE_ESTIMATE, POSE_MOCAP, SCENE_SETPOINT, SCENE_WORLD
 from gcs.mission.recording import PATH, POSE_TF, SCENE, SETPOINT
 from logs import Recorder
-from logs.foxglove import WELL_KNOWN_SCHEMAS, foxglove_scene_from_boxes, stamped
-from logs.recorder import RAW_FRAME_SCHEMA
+from logs.flight_file import RAW_FRAME_SCHEMA
+from logs.foxglove import foxglove_scene_from_boxes, stamped
+from logs.foxglove_schemas import WELL_KNOWN_SCHEMAS
 from tests.logs.foxglove_schema_check import foxglove_schema_problems
 from tests.logs.official_schemas import check_recording, problems, require_schemas
 

@@ -256,7 +256,7 @@ def test_cli_drops_the_downlink_window_and_reports_counters() -> None:
     port = server.getsockname()[1]
     # a 20 s simulated window at 10x: 2 s of wall time from the station's connection
     proc = subprocess.Popen(
-        [sys.executable, "-m", "sitl.fault_proxy", "--target", f"tcp:127.0.0.1:{port}",
+        [sys.executable, "-m", "sitl.fault_proxy_cli", "--target", f"tcp:127.0.0.1:{port}",
          "--drop", "down:0+20", "--time-scale", "10", "--seed", "2"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
     try:
@@ -296,7 +296,7 @@ def test_cli_drops_the_downlink_window_and_reports_counters() -> None:
 @pytest.mark.parametrize("flag", ["--drop down:30", "--loss sideways:0.3", "--delay up:-1",
                                   "--bitflip both:0.1@5+0"])
 def test_cli_bad_flag_is_one_line(flag: str) -> None:
-    done = subprocess.run([sys.executable, "-m", "sitl.fault_proxy", "--target",
+    done = subprocess.run([sys.executable, "-m", "sitl.fault_proxy_cli", "--target",
                            "tcp:127.0.0.1:5760", *flag.split()], capture_output=True,
                           text=True, cwd=ROOT, timeout=30)
     assert done.returncode == 2

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sitl import physics
+from sitl import physics_state
 from sitl.battery import battery_state, cell_ocv_v, terminal_voltage_v
 from sitl.motors import max_speed_radps, thrust_n
 from sitl.params import GRAVITY_MPS2, ParamError, VehicleParams
@@ -170,10 +170,10 @@ def test_drop_lands_inelastically_and_never_bounces() -> None:
 def test_friction_stops_a_sliding_landing() -> None:
     p = VehicleParams()
     world = default_world()
-    s = physics.PhysicsState.at_rest(p, world, (0.0, 0.0, 0.0))
+    s = physics_state.PhysicsState.at_rest(p, world, (0.0, 0.0, 0.0))
     s = dataclasses.replace(s, vel_n=np.array([1.0, 0.0, 0.0]))
     for _ in range(200):
-        s = physics.step(s, [0.0] * 4, p, DT, world)
+        s = physics_state.step(s, [0.0] * 4, p, DT, world)
     assert s.vel_n[0] == 0.0
     stop = 1.0 / (2 * p.ground_friction * GRAVITY_MPS2)
     assert s.pos_n[0] == pytest.approx(stop, rel=0.05)
@@ -181,9 +181,9 @@ def test_friction_stops_a_sliding_landing() -> None:
 
 def test_pure_step_does_not_mutate_and_is_deterministic() -> None:
     p, world = VehicleParams(), default_world()
-    s0 = physics.PhysicsState.at_rest(p, world, (0.0, 0.0, -1.0))
-    a = physics.step(s0, [0.6, 0.5, 0.55, 0.5], p, 0.02, world)
-    b = physics.step(s0, [0.6, 0.5, 0.55, 0.5], p, 0.02, world)
+    s0 = physics_state.PhysicsState.at_rest(p, world, (0.0, 0.0, -1.0))
+    a = physics_state.step(s0, [0.6, 0.5, 0.55, 0.5], p, 0.02, world)
+    b = physics_state.step(s0, [0.6, 0.5, 0.55, 0.5], p, 0.02, world)
     assert s0.pos_n[2] == -1.0 and s0.vel_n[2] == 0.0
     np.testing.assert_array_equal(a.pos_n, b.pos_n)
     np.testing.assert_array_equal(a.q_nb, b.q_nb)
@@ -317,11 +317,11 @@ def test_params_validate_and_load_from_toml() -> None:
 def test_sliding_off_a_box_edge_falls_to_the_floor() -> None:
     p = VehicleParams()
     world = World(boxes=(Box("crate", (-0.5, -0.5, -0.4), (0.5, 0.5, 0.0)),))
-    s = physics.PhysicsState.at_rest(p, world, (0.4, 0.0, -0.4))
+    s = physics_state.PhysicsState.at_rest(p, world, (0.4, 0.0, -0.4))
     assert s.on_ground and s.pos_n[2] == pytest.approx(-0.4 - p.gear_height_m)
     s = dataclasses.replace(s, vel_n=np.array([1.5, 0.0, 0.0]))
     for _ in range(400):
-        s = physics.step(s, [0.0] * 4, p, DT, world)
+        s = physics_state.step(s, [0.0] * 4, p, DT, world)
     assert s.on_ground and s.pos_n[2] == pytest.approx(-p.gear_height_m)
     assert s.pos_n[0] > 0.5
 
@@ -333,8 +333,8 @@ def test_sliding_off_a_box_edge_falls_to_the_floor() -> None:
 )
 def test_any_throttles_keep_the_state_sane(cmd: list[float], seconds: float) -> None:
     p, world = VehicleParams(), default_world()
-    s = physics.PhysicsState.at_rest(p, world, (0.0, 0.0, -1.0))
-    s = physics.step(s, cmd, p, seconds, world)
+    s = physics_state.PhysicsState.at_rest(p, world, (0.0, 0.0, -1.0))
+    s = physics_state.step(s, cmd, p, seconds, world)
     assert np.all(np.isfinite(s.pos_n)) and np.all(np.isfinite(s.omega_b))
     assert float(np.dot(s.q_nb, s.q_nb)) == pytest.approx(1.0, abs=1e-9)
     assert s.pos_n[2] <= -p.gear_height_m + 1e-12  # never below the floor
