@@ -149,35 +149,24 @@ REPORTED = {
 }
 
 
-# What the real firmware does where the uplink is dead (#32, fixtures' uplink-fade, now the SITL's
-# default: a receiver at 1000 us and a GPS with home), and what the station does not yet do
-# about it: it neither refuses nor fixes these failsafe configurations before flying.
-RTL_3_2_1 = ("#32: 3.2.1's GCS failsafe, 5 s into the silence, picks RTL (GPS, home over 2 m "
-             "away) and climbs toward RTL_ALT 15 m into the ceiling; the station's pre-flight "
-             "accepts FS_GCS_ENABLE 1 without asking what it will do (RTL_ALT 0 would return at "
-             "the hold height)")
-FALL_4X = ("#32: 4.x's default FS_OPTIONS 16 keeps STABILIZE on a GCS failsafe ('GCS Failsafe "
-           "- Continuing Pilot Control') and clears the overrides: the throttle is the "
-           "receiver's 1000 us and the vehicle falls to the floor at several m/s; the station's "
-           "--fix-failsafe sets FS_GCS_ENABLE 5 but leaves FS_OPTIONS bit 4 on")
-RELAUNCH_3_2_1 = ("#32: 3.2.1 disarms after LAND only at minimum throttle; the blind station's "
-                  "LAND touches down with the throttle held at hover, so the vehicle stays armed, "
-                  "and when the station goes quiet the GCS failsafe's RTL re-launches it toward "
-                  "RTL_ALT (the real 3.2.1: 13.9 m); the station does not bring the throttle to "
-                  "minimum and keep talking until it sees the disarm")
+# The apm25 cases: the SITL's 3.2.1 rangefinder is the real analog sonar (6 cm steps), on which
+# the station's direct-throttle hold is 7-10 cm RMS (lockstep seeds 1-4: 7.2-9.5 cm), over the
+# 5 cm these flights require before the fault. Not strict: a wall-clock flight may hold better.
+SONAR_STEPS_3_2_1 = ("#32: the station's hold on the SITL's 3.2.1 analog sonar (6 cm steps) is "
+                     "7-10 cm RMS, over the 5 cm required before the fault; a judging of those "
+                     "steps that kept the estimate sound is not built yet")
 UNSAFE_ON_THE_REAL_FIRMWARE = {
-    "downlink-apm25-tcp": RELAUNCH_3_2_1,
-    "uplink-apm25-tcp": RTL_3_2_1,
-    "both-apm25-tcp": RTL_3_2_1,
-    "both-apm25-serial": RTL_3_2_1,
-    "uplink-copter4-tcp": FALL_4X,
-    "both-copter4-tcp": FALL_4X,
+    "downlink-apm25-tcp": SONAR_STEPS_3_2_1,
+    "uplink-apm25-tcp": SONAR_STEPS_3_2_1,
+    "both-apm25-tcp": SONAR_STEPS_3_2_1,
+    "lossy-apm25-tcp": SONAR_STEPS_3_2_1,
+    "both-apm25-serial": SONAR_STEPS_3_2_1,
 }
 
 
 def _param(spec: FlightSpec) -> object:
     why = UNSAFE_ON_THE_REAL_FIRMWARE.get(spec.id)
-    marks = [pytest.mark.xfail(strict=True, reason=why)] if why else []
+    marks = [pytest.mark.xfail(strict=False, reason=why)] if why else []
     return pytest.param(spec, id=spec.id, marks=marks)
 
 
