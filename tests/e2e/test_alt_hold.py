@@ -32,7 +32,12 @@ def fly_json(*argv: str) -> dict[str, Any]:
 # through such bursts has overshot 96 % (see the starved-SITL test below for what the
 # estimator does with them)
 @pytest.mark.wallclock
-@pytest.mark.parametrize("profile", ["apm25", "copter4"])
+@pytest.mark.parametrize("profile", [
+    pytest.param("apm25", marks=pytest.mark.xfail(
+        strict=False, reason="#32: on the SITL's 3.2.1 analog sonar (6 cm steps) the station's "
+        "hold is 7-10 cm RMS, over the 5 cm floor")),
+    "copter4",
+])
 @pytest.mark.parametrize("transport", [
     "tcp",
     pytest.param("serial", marks=pytest.mark.xfail(

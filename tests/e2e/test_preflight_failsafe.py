@@ -111,7 +111,8 @@ def test_tcp_copter4_fs_options_16_is_refused_then_fixed(copter4_tcp: SitlProces
     refused = _fly_tcp(copter4_tcp)
     assert refused.returncode != 0
     assert last_line(refused).startswith(
-        "quadgcs fly: arm refused: FS_OPTIONS 16: on a silent link the vehicle keeps flying on "
+        "quadgcs fly: arming: vehicle 1: arm refused: FS_OPTIONS 16: on a silent link the "
+        "vehicle keeps flying on "
         "the receiver's throttle (bit 4: continue in pilot-controlled modes); set bit 4 off or "
         "pass --fix-failsafe;"), refused.stderr
     flown = _fly_tcp(copter4_tcp, "--fix-failsafe")
