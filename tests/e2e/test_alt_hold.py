@@ -64,7 +64,12 @@ def test_holds_1m_and_settles_a_1m_step(transport: str, profile: str) -> None:
 # Alone (make test's `solo` pass): the stalls are the test; a third wall-clock neighbour's load
 # on top of them left copter4's step unsettled after 8 s in two runs of three at a time
 @pytest.mark.solo
-@pytest.mark.parametrize("profile", ["apm25", "copter4"])
+@pytest.mark.parametrize("profile", [
+    pytest.param("apm25", marks=pytest.mark.xfail(
+        strict=False, reason="#32: on the SITL's 3.2.1 analog sonar (6 cm steps) the station's "
+        "hold is 7-11 cm RMS, over the 6 cm bound")),
+    "copter4",
+])
 def test_a_starved_sitls_bursts_leave_the_hold_and_the_step_intact(profile: str) -> None:
     """The SITL stopped for 0.15 s of every 0.3 s (0.3 s of simulated time at 2x) falls
     behind, then sends what it missed at once. Taken as one averaged IMU sample per tick, the

@@ -39,10 +39,14 @@ RESULTS = "results.parquet"
 # other test process loses its ticks (make test runs `solo` tests alone)
 pytestmark = pytest.mark.solo
 
+# copter4: a 2 s hold on its whole-centimetre rangefinder is steady; apm25's 6 cm sonar steps
+# make a short hold wander past 10 cm (#32)
 GRID = """
 name = "grid"
 [fly]
 hold_s = 2.0
+profile = "copter4"
+fix_failsafe = true
 [axes]
 "station.altitude.gains.kp" = [3.0, 5.0]
 seed = [1, 2, 3]
