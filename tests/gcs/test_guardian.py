@@ -74,7 +74,11 @@ def _die_and_disarm(v: FakeVehicle, guardian: Guardian, stay_s: float = 0.0) -> 
                       and bool(v.state.overrides) and v.state.overrides[-1][2][2] == 1000,
                       EXIT_S)
     if stay_s:
-        time.sleep(stay_s)  # the time a vehicle stays armed: the guardian must not leave in it
+        # the vehicle stays armed while the guardian sends this many minimum-throttle frames
+        # (one per 25 ms tick): it must not leave in them
+        start = len(v.state.overrides)
+        assert wait_until(lambda: len(v.state.overrides) - start >= stay_s / 0.025 / 2,
+                          EXIT_S + stay_s)
         assert guardian._proc.poll() is None
     v.state.armed = False
     return guardian._proc.wait(EXIT_S)
@@ -105,8 +109,9 @@ def test_a_guardian_keeps_heartbeats_while_the_landed_vehicle_stays_armed() -> N
         guardian._sock.close()
         assert wait_until(lambda: v.state.mode == int(FlightMode.LAND), EXIT_S)
         hb0 = v.state.gcs_heartbeats
-        time.sleep(3.2)
-        assert guardian._proc.poll() is None and v.state.gcs_heartbeats - hb0 >= 2
+        # three more heartbeats (1 Hz) from a guardian that has not left the armed vehicle
+        assert wait_until(lambda: v.state.gcs_heartbeats - hb0 >= 3, EXIT_S + 3.0)
+        assert guardian._proc.poll() is None
         v.state.armed = False
         assert guardian._proc.wait(EXIT_S) == 0
 
