@@ -1,4 +1,4 @@
-"""The supervisor as a pure state machine: scripted inputs, no sockets, no clocks."""
+"""The supervisor on scripted ticks: arming, kill, take-off, landing, quitting, position."""
 
 from __future__ import annotations
 
@@ -7,90 +7,15 @@ import math
 import pytest
 
 from firmware_link.records import Dialect, FlightMode, MocapPose
-from gcs.control.altitude_controller import AltitudeController, AltitudeControllerParams
-from gcs.control.position_controller import PositionController, PositionControllerParams
-from gcs.control.throttle_curve import ThrottleCurve
-from gcs.estimation import AltEstimate, SonarStatus
+from gcs.estimation import SonarStatus
 from gcs.supervisor import (
     ActionKind,
     Intent,
     IntentKind,
-    LinkHealth,
-    Supervisor,
-    SupervisorOutput,
     SupervisorParams,
-    TickIn,
-    VehicleStatus,
 )
 from gcs.supervisor import SupervisorState as S
-
-DT = 0.025
-REST_M = 0.06
-
-
-class Script:
-    """Drives a supervisor tick by tick with a scripted vehicle."""
-
-    def __init__(self, dialect: Dialect = Dialect.APM25, **params: object) -> None:
-        self.sup = Supervisor(SupervisorParams.for_dialect(dialect, **params),
-                              AltitudeController(AltitudeControllerParams(),
-                                                 ThrottleCurve.for_dialect(dialect)),
-                              PositionController(PositionControllerParams()),
-                              rest_alt_m=REST_M, ground_alt_m=0.10)
-        self.t = 100.0
-        self.armed = False
-        self.mode = int(FlightMode.STABILIZE)
-        self.hb_t = self.t
-        self.rx_t = self.t
-        self.down = True  # the vehicle is heard
-        self.alt = REST_M
-        self.vel = 0.0
-        self.mocap: MocapPose | None = None
-        self.sonar = SonarStatus.USED  # what the estimator did with this tick's reading
-        self.outs: list[SupervisorOutput] = []
-
-    def tick(self, *intents: Intent) -> SupervisorOutput:
-        self.t += DT
-        if self.down:
-            self.rx_t = self.t
-            if self.t - self.hb_t >= 1.0:
-                self.hb_t = self.t
-        est = AltEstimate(self.t, self.alt, self.vel, 0.0, 0.0, True, self.sonar, 0.0, 0.0,
-                          False, 0.01, 0)
-        v = VehicleStatus(seen=True, armed=self.armed, mode=self.mode, heartbeat_t_s=self.hb_t,
-                          frame_age_s=self.t - self.rx_t)
-        out = self.sup.step(TickIn(self.t, DT, intents, v, est, 0.0, 0.0, self.mocap))
-        self.outs.append(out)
-        return out
-
-    def run(self, seconds: float) -> list[SupervisorOutput]:
-        n = round(seconds / DT)
-        return [self.tick() for _ in range(n)]
-
-    def heartbeat_now(self) -> None:
-        self.hb_t = self.t + DT  # the next tick carries a fresh heartbeat
-
-    def armed_in_stabilize(self) -> None:
-        self.tick(Intent(IntentKind.PREFLIGHT, ok=True, note="test"))
-        out = self.tick(Intent(IntentKind.ARM))
-        assert any(a.kind is ActionKind.ARM for a in out.actions)
-        self.armed = True
-        self.heartbeat_now()
-        self.tick()
-        assert self.sup.state is S.MANUAL
-
-    def hovering(self, alt_m: float = 1.0) -> None:
-        """Armed, in HOLD at alt_m (the vehicle follows perfectly)."""
-        self.armed_in_stabilize()
-        self.alt = alt_m
-        self.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=alt_m))
-        assert self.sup.state is S.HOLD
-
-
-def actions(outs: list[SupervisorOutput], kind: ActionKind) -> list[int | None]:
-    """Per tick that sent a `kind`, the mode of its first one."""
-    return [next(a.mode for a in o.actions if a.kind is kind)
-            for o in outs if any(a.kind is kind for a in o.actions)]
+from tests.gcs.supervisor_script import DT, REST_M, Script, actions
 
 
 def test_arm_refused_until_preflight_passes() -> None:
@@ -129,134 +54,6 @@ def test_kill_from_hold_throttle_min_next_tick_and_disarm_at_5_hz_until_seen() -
     s.heartbeat_now()
     s.tick()
     assert s.sup.state is S.DISARMED
-
-
-@pytest.mark.parametrize("fault", ["down", "up_and_down"])
-def test_kill_while_the_link_is_lost_still_cuts_and_repeats(fault: str) -> None:
-    s = Script()
-    s.hovering()
-    s.down = False
-    s.run(2.0)
-    assert s.sup.state is S.LINK_LOST
-    out = s.tick(Intent(IntentKind.KILL))
-    assert out.command is not None and out.command.throttle_us == 1000 and out.heartbeat
-    outs = s.run(5.0)  # silence never returns once killed
-    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
-    assert len(actions(outs, ActionKind.DISARM)) >= 25  # 3.2.1: no force
-    s.down = True
-    s.armed = False
-    s.heartbeat_now()
-    s.tick()
-    assert s.sup.state is S.DISARMED
-
-
-def test_kill_on_apm25_in_land_switches_to_stabilize_so_disarm_is_accepted() -> None:
-    s = Script(Dialect.APM25)
-    s.hovering()
-    s.mode = int(FlightMode.LAND)
-    s.heartbeat_now()
-    s.tick()
-    out = s.tick(Intent(IntentKind.KILL))
-    kinds = [a.kind for a in out.actions]
-    assert kinds == [ActionKind.SET_MODE, ActionKind.DISARM]
-    assert out.actions[0].mode == FlightMode.STABILIZE
-
-
-def test_short_gap_holds_hover_throttle_level_then_hold_resumes() -> None:
-    s = Script()
-    s.hovering()
-    s.run(12.0)  # steady long enough for the flown hover (2 s time constant) to settle
-    # the hover the hold flies at: learned, with its integrator's trim (#32)
-    hover = s.sup.alt_ctrl.flown_hover_stick_us()
-    s.down = False
-    outs = s.run(0.6)
-    held = [o for o in outs if o.link is LinkHealth.DEGRADED]
-    assert held and all(o.command == held[0].command for o in held)
-    cmd = held[0].command
-    assert cmd is not None and abs(cmd.throttle_us - hover) <= 3 and cmd.roll_us == 1500
-    assert s.sup.state is S.HOLD
-    s.down = True
-    out = s.tick()
-    assert out.link is LinkHealth.OK and s.sup.state is S.HOLD and s.sup.alt is not None
-
-
-@pytest.mark.parametrize("dialect", [Dialect.APM25, Dialect.COPTER4])
-def test_link_lost_while_armed_on_the_floor_keeps_the_throttle_at_minimum(
-        dialect: Dialect) -> None:
-    # 3.2.1's hover stick is THR_MID, 1500 us: sent to an armed vehicle on the floor, it lifts
-    s = Script(dialect)
-    s.armed_in_stabilize()
-    s.run(1.0)
-    assert s.sup.alt_ctrl.hover_stick_us() > 1300
-    s.down = False
-    outs = s.run(3.0)
-    assert s.sup.state is S.LINK_LOST
-    assert all(o.command is not None and o.command.throttle_us == 1000 for o in outs)
-    assert actions(outs, ActionKind.SET_MODE)  # LAND is still asked: on the floor it disarms
-
-
-def test_link_lost_in_manual_flight_never_raises_the_pilots_throttle() -> None:
-    s = Script()
-    s.armed_in_stabilize()
-    s.tick(Intent(IntentKind.STICKS, throttle_us=1000))
-    s.tick(Intent(IntentKind.STICKS, throttle_us=1350))  # descending, below hover
-    s.alt = 1.2
-    s.run(0.5)
-    hover = s.sup.alt_ctrl.flown_hover_stick_us()
-    assert hover > 1350
-    s.down = False
-    outs = s.run(2.0)
-    assert s.sup.state is S.LINK_LOST
-    assert all(o.command is not None and o.command.throttle_us <= 1350 for o in outs)
-
-
-def test_long_gap_lands_stays_until_disarmed_and_nothing_resumes() -> None:
-    """Until #32 the station went silent 3 s after the loss; on the real 3.2.1 a landed, armed
-    vehicle then met its GCS failsafe, whose RTL climbed to 14 m. Now LAND and heartbeats go
-    on, the throttle at minimum once a LAND from the height last seen has touched down."""
-    s = Script()
-    s.hovering()
-    s.run(12.0)  # steady long enough for the flown hover (2 s time constant) to settle
-    hover = s.sup.alt_ctrl.flown_hover_stick_us()
-    s.down = False
-    outs = s.run(1.6)
-    assert s.sup.state is S.LINK_LOST
-    outs += s.run(2.9)
-    lost = [o for o in outs if o.state is S.LINK_LOST]  # in the air: hover, no climb, no fall
-    assert lost and all(o.command is not None and abs(o.command.throttle_us - hover) <= 3
-                        for o in lost)
-    lands = actions(outs, ActionKind.SET_MODE)
-    assert lands and all(m == FlightMode.LAND for m in lands)
-    assert len(lands) >= 5  # every 0.5 s while the uplink may work
-    # LAND from 0.94 m over the rest: touched down 3 + 0.94 / 0.5 + 3 s after the loss
-    lost_at = s.sup._lost_at_s
-    outs = s.run(5.5)
-    assert s.sup.state is S.LINK_LOST
-    assert all(o.heartbeat and o.command is not None for o in outs)
-    down = [s.t - 5.5 + 0.025 * (i + 1) for i, o in enumerate(outs)
-            if o.command is not None and o.command.throttle_us == 1000]
-    assert down and down[0] - lost_at == pytest.approx(3.0 + 0.94 / 0.5 + 3.0, abs=0.03)
-    assert all(abs(o.command.throttle_us - hover) <= 3 for o in outs[:len(outs) - len(down)]
-               if o.command is not None)
-    assert any("throttle minimum so it disarms" in n.text for o in outs for n in o.notes)
-    outs = s.run(30.0)  # never quiet while it may be armed
-    assert all(o.heartbeat and o.command is not None and o.command.throttle_us == 1000
-               for o in outs)
-    assert len(actions(outs, ActionKind.SET_MODE)) >= 55
-    # the link comes back with the vehicle still in STABILIZE: keep asking for LAND
-    s.down = True
-    s.heartbeat_now()
-    outs = s.run(1.0)
-    assert s.sup.state is S.LINK_LOST and all(o.heartbeat for o in outs)
-    assert actions(outs, ActionKind.SET_MODE)
-    assert s.sup.alt is None  # PC hold did not resume by itself
-    s.mode = int(FlightMode.LAND)
-    s.heartbeat_now()
-    s.tick()
-    assert s.sup.state is S.VEHICLE
-    out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=1.0))
-    assert s.sup.state is S.VEHICLE and any("refused" in n.text for n in out.notes)
-    assert out.command is not None and out.command.throttle_us == 1000 and out.heartbeat
 
 
 def test_land_mode_by_itself_ends_pc_control_and_stabilize_keeps_throttle_at_minimum() -> None:
@@ -454,15 +251,6 @@ def test_position_hold_levels_when_motion_capture_goes_stale() -> None:
     assert out.command is not None and out.command.roll_us < 1500  # target north: roll left
     s.run(0.5)  # the pose is now older than 0.25 s
     assert s.outs[-1].command is not None and s.outs[-1].command.roll_us == 1500
-
-
-def test_intents_are_ignored_while_the_link_is_lost_except_kill() -> None:
-    s = Script()
-    s.hovering()
-    s.down = False
-    s.run(1.6)
-    out = s.tick(Intent(IntentKind.ALT_HOLD, setpoint_m=2.0))
-    assert s.sup.state is S.LINK_LOST and any("ignored" in n.text for n in out.notes)
 
 
 def test_the_commanded_acceleration_is_told_only_while_the_hold_flies_the_throttle() -> None:
