@@ -29,15 +29,18 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from firmware_link import (
+    DEFAULT_CONNECT_TIMEOUT_S,
     LinkUsageError,
     ParamError,
     VehicleLink,
     diff_params,
     format_param_value,
+    open_when_up,
     read_parm_file,
     write_parm_file,
 )
 from firmware_link.params import check_param_name, check_param_value
+from gcs.commands._vehicle_args import add_connect_timeout_argument, connect_timeout
 from gcs.errors import RuntimeFault, UsageError
 from gcs.sitl_process import SitlOptions, SitlProcess
 from gcs.toml_file import read_signing_key
@@ -60,6 +63,7 @@ def _add_vehicle_flags(p: argparse.ArgumentParser, *, on_action: bool) -> None:
     p.add_argument("--connect", metavar="URL", default=d(None),
                    help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
                         "default: start the bundled SITL")
+    add_connect_timeout_argument(p, d(DEFAULT_CONNECT_TIMEOUT_S))
     p.add_argument("--profile", choices=("apm25", "copter4"), default=d("apm25"),
                    help="firmware profile of the bundled SITL (default apm25)")
     p.add_argument("--world", type=Path, default=d(None), help="world TOML for the bundled SITL")
@@ -139,9 +143,11 @@ def _vehicle(args: argparse.Namespace) -> Iterator[VehicleLink]:
             endpoints = sitl.start()
             stack.callback(sitl.stop)
             url = endpoints.url(1, serial=args.serial)
+            link = stack.enter_context(VehicleLink.open(url, signing_key=key))
         else:
-            url = args.connect
-        link = stack.enter_context(VehicleLink.open(url, signing_key=key))
+            link = stack.enter_context(open_when_up(
+                args.connect, timeout_s=connect_timeout(args), signing_key=key,
+                on_wait=lambda line: print(line, file=sys.stderr, flush=True)))
         yield link
 
 

@@ -53,6 +53,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
     sysids = tuple(v.sysid for v in spec.vehicles)
     session_options = SessionOptions(
         command="mission", connect=options.connect, mocap=options.mocap, profile=spec.profile,
+        connect_timeout_s=options.connect_timeout_s,
         world=spec.world_path, speedup=speedup, seed=options.seed, record=options.record,
         output=options.output, sysids=sysids, fix_failsafe=options.fix_failsafe,
         foxglove=options.foxglove,

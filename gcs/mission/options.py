@@ -13,6 +13,7 @@ class RunOptions:
 
     kinematic: bool = False
     connect: str | None = None
+    connect_timeout_s: float = 30.0  # how long `connect` is waited for (firmware_link.wait_up)
     mocap: str | None = None
     record: bool = True
     output: Path = Path("flights")
