@@ -21,8 +21,7 @@ import socket
 import sys
 from typing import Any, Protocol, runtime_checkable
 
-from firmware_link import LinkError, parse_connection_string
-from firmware_link.records import Dialect
+from firmware_link import FirmwareInfo, LinkError, parse_connection_string
 from gcs.clock import Clock
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
 from gcs.errors import FlightFailed, UsageError
@@ -114,7 +113,8 @@ def _metres(x: float) -> float | None:
     return round(x, 4) if math.isfinite(x) else None
 
 
-def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> dict[str, Any]:
+def _summary_dict(s: FlightSummary, recording: str | None,
+                  firmware: FirmwareInfo) -> dict[str, Any]:
     d: dict[str, Any] = {
         "rms_error_m": _metres(s.rms_error_m),
         "max_error_m": _metres(s.max_error_m),
@@ -132,7 +132,9 @@ def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> 
         "lost_messages": s.lost_messages,
         "corrupted_frames": s.corrupted,
         "hover_throttle": round(s.hover_throttle, 4),
-        "dialect": dialect.value,
+        "dialect": firmware.dialect.value,
+        "firmware": firmware.name,
+        "firmware_source": firmware.source,
         "recording": recording,
     }
     if s.estimator is not None:
@@ -167,6 +169,7 @@ def _print_summary(d: dict[str, Any]) -> None:
     print(f"loop: jitter p50 {d['jitter_p50_ms']:.3f} ms, p99 {d['jitter_p99_ms']:.3f} ms, "
           f"compute p99 {d['compute_p99_ms']:.3f} ms, overruns {d['overruns']} "
           f"of {d['ticks']} ticks")
+    print(f"firmware {d['firmware']} (identified by {d['firmware_source'] or 'nothing'})")
     print(f"link ({d['dialect']}): {d['rx_messages']} messages received, "
           f"{d['lost_messages']} lost, {d['corrupted_frames']} corrupted")
     if "estimator" in d:
@@ -247,7 +250,7 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
         snap = v.station.snapshot(loop_stats=False)
         raise FlightFailed(f"{exc}; link down {snap.link_down_s:.1f} s; recording "
                            f"{path or 'off'}") from None
-    d = _summary_dict(runner.summary(v.truth_series()), path, v.link.dialect)
+    d = _summary_dict(runner.summary(v.truth_series()), path, v.link.firmware)
     d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
     d["status"] = "ok"
     if session.forwarder is not None:

@@ -43,6 +43,7 @@ def _child(options: SessionOptions, conn: Connection) -> None:
                 v.station, url=v.url,
                 recording=str(v.recorder.path) if v.recorder is not None else None,
                 dialect=v.link.dialect.value, signing=v.link.signing, forward=v.link.forward,
+                firmware=v.link.firmware.name, firmware_source=v.link.firmware.source,
             )
             v.station.start()
             conn.send(("ready", backend.view()))

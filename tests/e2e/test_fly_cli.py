@@ -35,6 +35,9 @@ def test_fly_json_records_the_flight(tmp_path: Path) -> None:
     for key in ("rms_error_m", "max_error_m", "jitter_p99_ms", "overruns", "recording"):
         assert key in summary
     assert summary["error_source"] == "truth"
+    # 3.2.1 gives no version at connect (only its parameter list carries the banner)
+    assert (summary["firmware"], summary["firmware_source"]) == (
+        "ArduCopter 3.x", "parameters: THR_MID"), summary
     assert summary["rms_error_m"] < 0.1
     assert summary["recording"] == str(out)
     rec = open_recording(out)
@@ -110,7 +113,8 @@ def test_fly_connect_waits_for_a_vehicle_that_is_not_up_yet() -> None:
     port = _free_tcp_port()
     url = f"tcp:127.0.0.1:{port}"
     fly = subprocess.Popen([sys.executable, "-m", "gcs", "fly", "--connect", url,
-                            "--connect-timeout", "90", "--json", "--hold", "2", "--no-record"],
+                            "--connect-timeout", "90", "--json", "--hold", "2", "--no-record",
+                            "--fix-failsafe"],  # 4.x ships its GCS failsafe off
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
     sitl: SitlProcess | None = None
     try:
@@ -119,7 +123,7 @@ def test_fly_connect_waits_for_a_vehicle_that_is_not_up_yet() -> None:
         first = _wait_for_line(err, f"waiting for the vehicle on {url}", 60.0)
         assert "connection refused" in first[-1] and "giving up in 90 s" in first[-1]
         assert fly.poll() is None
-        sitl = SitlProcess(["--tcp", str(port)], ROOT)
+        sitl = SitlProcess(["--tcp", str(port), "--profile", "copter4"], ROOT)
         out, _ = fly.communicate(timeout=180)
         rest: list[str] = []
         while not err.empty():
@@ -127,6 +131,9 @@ def test_fly_connect_waits_for_a_vehicle_that_is_not_up_yet() -> None:
         assert fly.returncode == 0, (out, first, rest)
         summary = json.loads(out.strip().splitlines()[-1])
         assert summary["rms_error_m"] < 0.15, summary
+        # the firmware named, and how: 4.x answers AUTOPILOT_VERSION
+        assert (summary["firmware"], summary["firmware_source"]) == (
+            "ArduCopter V4.7.0-dev", "AUTOPILOT_VERSION"), summary
     finally:
         if fly.poll() is None:
             fly.kill()
