@@ -59,6 +59,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                         "same speed-up")
     p.add_argument("--takeoff-delay", type=float, default=0.0, metavar="S",
                    help="stay armed on the floor this long before taking off (default 0)")
+    p.add_argument("--arm-timeout", type=float, default=plan.arm_timeout_s, metavar="S",
+                   help="ask the vehicle to arm again, showing the firmware's refusal, until "
+                        f"this long after the first request (default {plan.arm_timeout_s:g}; "
+                        "4.x's pre-arm refuses for ~24 s after boot)")
     p.add_argument("--lockstep", action="store_true",
                    help="fly the bundled SITL in this process on simulated time, as fast as the "
                         "CPU allows and the same flight for the same --seed (no --connect)")
@@ -75,9 +79,10 @@ def _plan(args: argparse.Namespace) -> FlightPlan:
     try:
         return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step,
                           step_observe_s=args.step_watch, step_band_m=args.step_band,
-                          takeoff_delay_s=args.takeoff_delay)
+                          takeoff_delay_s=args.takeoff_delay, arm_timeout_s=args.arm_timeout)
     except ValueError as exc:
-        raise UsageError(f"--alt/--hold/--step/--step-watch/--step-band: {exc}") from None
+        raise UsageError(f"--alt/--hold/--step/--step-watch/--step-band/--arm-timeout: "
+                         f"{exc}") from None
 
 
 class LivePrinter:
