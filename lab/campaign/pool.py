@@ -9,7 +9,8 @@ head's machine (`~/.ray/auth_token`, which any local `ray.init()` creates, `RAY_
 `RAY_AUTH_TOKEN_PATH`), and a client then needs `RAY_AUTH_MODE=token` and the same token. Ray
 enables it by itself only for a cluster it finds on its own, never for an explicit address: so
 with `RAY_AUTH_MODE` unset and a token here, the join is made in token mode, as Ray does for a
-local cluster. A join that fails says in one line what to set. The local Ray starts with the
+local cluster (a cluster without authentication takes such a client all the same). A join that
+fails says in one line what to set. The local Ray starts with the
 number of CPUs asked (all of this machine's by default), no dashboard, and none of what only
 the dashboard and the state API read (metrics export, task events, the timeline): on two
 cores their threads cost the runs about 4 % of the CPU.
