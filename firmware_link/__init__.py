@@ -20,7 +20,7 @@ ground stations watching through this one: `forward.Forwarder`.
 
 from firmware_link.connection import ConnectionSpec, Transport, parse_connection_string
 from firmware_link.dialect import dialect_of_frame
-from firmware_link.errors import LinkError, LinkUsageError
+from firmware_link.errors import LinkError, LinkUsageError, VehicleNotUp
 from firmware_link.firmware import FirmwareInfo
 from firmware_link.forward import Forwarder, ForwardPort, ForwardStats
 from firmware_link.mocap_link import MocapLink
@@ -46,8 +46,10 @@ from firmware_link.streams import (
     wanted_streams,
 )
 from firmware_link.vehicle_link import VehicleLink, clamp_pwm_us
+from firmware_link.wait_up import DEFAULT_CONNECT_TIMEOUT_S, open_when_up
 
 __all__ = [
+    "DEFAULT_CONNECT_TIMEOUT_S",
     "BringUpReport",
     "BringUpStep",
     "ConnectionSpec",
@@ -67,10 +69,12 @@ __all__ = [
     "StreamWanted",
     "Transport",
     "VehicleLink",
+    "VehicleNotUp",
     "clamp_pwm_us",
     "dialect_of_frame",
     "diff_params",
     "format_param_value",
+    "open_when_up",
     "parse_connection_string",
     "parse_parm",
     "plan_streams",

@@ -13,3 +13,8 @@ class LinkUsageError(LinkError):
     """The caller asked for something malformed (bad connection string, bad key file): exit 2."""
 
     exit_code = 2
+
+
+class VehicleNotUp(LinkError):
+    """Nothing answers at the vehicle's address yet (refused, no device, no heartbeat): a
+    vehicle still booting looks like this, so a caller may wait and try again."""

@@ -53,6 +53,9 @@ class FirmwareInfo:
     wire: WireVersion
     evidence: tuple[str, ...]
     version_number: tuple[int, int, int] | None = None
+    # what told `name`: "AUTOPILOT_VERSION", "STATUSTEXT banner", "parameters: THR_MID",
+    # "heartbeat only: MAVLink 1 frames"; "" before anything was heard
+    source: str = ""
 
     @property
     def name(self) -> str:
@@ -61,12 +64,19 @@ class FirmwareInfo:
         return self.version or family.get(self.dialect, "unknown firmware")
 
     @property
+    def label(self) -> str:
+        """The name and how it was told, as a pilot reads it: "ArduCopter V4.7.0-dev
+        (AUTOPILOT_VERSION)", "ArduCopter 3.x (parameters: THR_MID)"."""
+        return f"{self.name} ({self.source})" if self.source else self.name
+
+    @property
     def summary(self) -> str:
-        """One line: version (or family), dialect, wire and GCS-id parameter."""
+        """One line: version (or family), dialect, wire, GCS-id parameter, the source."""
         given = "" if self.version else " (no version given)"
+        told = f"; identified by {self.source}" if self.source else ""
         return (
             f"{self.name}{given}: dialect {self.dialect.name}, MAVLink {int(self.wire)} on this "
-            f"port, GCS id in {self.gcs_sysid_param}"
+            f"port, GCS id in {self.gcs_sysid_param}{told}"
         )
 
 
@@ -132,6 +142,7 @@ def decide_firmware(ev: FirmwareEvidence) -> FirmwareInfo:
     wire = ev.wire or WireVersion.V2
     dialect = Dialect.UNKNOWN
     version = ""
+    source = ""
     number: tuple[int, int, int] | None = None
     seen = ev.params_seen
     name = "ArduCopter" if ev.mav_type is None or ev.mav_type in _COPTER_TYPES else "ArduPilot"
@@ -141,6 +152,7 @@ def decide_firmware(ev: FirmwareEvidence) -> FirmwareInfo:
         number = (major, minor, patch)
         version = f"{name} V{major}.{minor}.{patch}{suffix}"
         dialect = Dialect.COPTER4 if major >= 4 else Dialect.APM25
+        source = "AUTOPILOT_VERSION"
         git = f", git {ev.git_hash}" if ev.git_hash else ""
         notes.append(f"AUTOPILOT_VERSION: {version}{git} ⇒ {dialect.name}")
     elif ev.version_refused:
@@ -164,6 +176,9 @@ def decide_firmware(ev: FirmwareEvidence) -> FirmwareInfo:
         notes.append(f"no such parameter: {', '.join(absent)}")
     if dialect is Dialect.UNKNOWN:
         dialect = by_params
+        if by_params is not Dialect.UNKNOWN:
+            told = sorted(seen & {GCS_ID_NEW, HOVER_4X, THR_MID_3X})
+            source = f"parameters: {', '.join(told)}"
     elif by_params not in (Dialect.UNKNOWN, dialect):
         notes.append(f"the parameters suggest {by_params.name}; AUTOPILOT_VERSION is trusted")
 
@@ -174,6 +189,7 @@ def decide_firmware(ev: FirmwareEvidence) -> FirmwareInfo:
         notes.append(f"version banner {ev.banner!r}")
         if not version:
             version, number = text, b_number
+            source = "STATUSTEXT banner"
         if dialect is Dialect.UNKNOWN:
             dialect = b_dialect
             notes.append(f"the banner ⇒ {b_dialect.name}")
@@ -184,6 +200,7 @@ def decide_firmware(ev: FirmwareEvidence) -> FirmwareInfo:
     if ev.wire is not None:
         if dialect is Dialect.UNKNOWN:
             dialect = hint
+            source = f"heartbeat only: MAVLink {int(wire)} frames"
             notes.append(
                 f"only the wire version: MAVLink {int(wire)} frames ⇒ {hint.name} (a hint)"
             )
@@ -208,4 +225,5 @@ def decide_firmware(ev: FirmwareEvidence) -> FirmwareInfo:
         wire=wire,
         evidence=tuple(notes),
         version_number=number,
+        source=source,
     )

@@ -21,7 +21,7 @@ import serial
 
 from firmware_link.byte_transport import READ_BUDGET_BYTES, ByteTransport, TransportClosed
 from firmware_link.connection import ConnectionSpec, Transport
-from firmware_link.errors import LinkError
+from firmware_link.errors import LinkError, VehicleNotUp
 
 READ_CHUNK_BYTES = 65536
 # The kernel's own send buffer is a queue the link cannot see or trim: Linux lets a TCP socket's
@@ -69,15 +69,17 @@ class TcpTransport(_Descriptor):
         try:
             sock = socket.create_connection((spec.host, spec.port), timeout=timeout_s)
         except ConnectionRefusedError:
-            raise LinkError(
+            raise VehicleNotUp(
                 f"{spec.url}: connection refused (nothing listens on {spec.host}:{spec.port})"
             ) from None
         except TimeoutError:
-            raise LinkError(
+            raise VehicleNotUp(
                 f"{spec.url}: no answer from {spec.host}:{spec.port} within {timeout_s:.1f} s"
             ) from None
-        except OSError as exc:
+        except socket.gaierror as exc:  # a misspelt host does not come up by waiting
             raise LinkError(f"{spec.url}: cannot connect: {exc.strerror or exc}") from None
+        except OSError as exc:  # unreachable: a network or vehicle still coming up
+            raise VehicleNotUp(f"{spec.url}: cannot connect: {exc.strerror or exc}") from None
         return cls._ready(spec, sock)
 
     @classmethod
@@ -296,7 +298,10 @@ class SerialTransport(_SerialLine):
                 reason = "no such device"
             else:
                 reason = text
-            raise LinkError(f"{spec.url}: cannot open serial port: {reason}") from None
+            # a USB adapter not plugged in yet is a device that does not exist yet
+            missing = "No such file" in text
+            raise (VehicleNotUp if missing else LinkError)(
+                f"{spec.url}: cannot open serial port: {reason}") from None
         except (OSError, ValueError) as exc:
             raise LinkError(f"{spec.url}: cannot open serial port: {exc}") from None
         return cls(spec, port)

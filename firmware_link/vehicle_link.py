@@ -27,7 +27,7 @@ from firmware_link.bring_up import StreamBringUp
 from firmware_link.byte_transport import ByteTransport, TransportClosed
 from firmware_link.connection import ConnectionSpec, parse_connection_string
 from firmware_link.dialect import MAVLINK1_CANNOT_SIGN
-from firmware_link.errors import LinkError, LinkUsageError
+from firmware_link.errors import LinkError, LinkUsageError, VehicleNotUp
 from firmware_link.firmware import FirmwareInfo, decide_firmware
 from firmware_link.forward import ForwardPort
 from firmware_link.frames import FrameEndpoint, RawTap
@@ -42,6 +42,7 @@ from firmware_link.transport import open_transport
 
 SIGNING_ON = "MAVLink 2 signing on: outgoing frames signed, unsigned frames refused"
 CLOSE_FLUSH_S = 0.5  # close() gives the override release this long to get out
+WAIT_NOTICE_S = 1.0  # a heartbeat later than this is worth telling the pilot about
 
 __all__ = ["MavResult", "VehicleLink", "clamp_pwm_us"]
 
@@ -66,10 +67,13 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
         wall_clock: Callable[[], float] = time.time,
         identify: bool = True,
         forward: ForwardPort | None = None,
+        on_wait: Callable[[str], None] | None = None,
     ) -> VehicleLink:
         """Open `url` and return once a vehicle heartbeat was seen and (with `identify`) its
-        firmware found out; LinkError otherwise. With `forward`, other ground stations hear
-        the vehicle from the first frame (`firmware_link.forward`)."""
+        firmware found out; LinkError otherwise (VehicleNotUp when nothing answered: see
+        `firmware_link.wait_up`). With `forward`, other ground stations hear the vehicle from
+        the first frame (`firmware_link.forward`). `on_wait` gets one line when no heartbeat
+        came within a second, so a long wait does not look like a hang."""
         spec = parse_connection_string(url)
         for name, value in (("source_system", source_system), ("target_system", target_system)):
             if value is not None and not 1 <= value <= 255:
@@ -97,7 +101,7 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
                 accept_unsigned=True,
             )
         try:
-            link._await_vehicle(target_system, wait_heartbeat_s, install_signing_key)
+            link._await_vehicle(target_system, wait_heartbeat_s, install_signing_key, on_wait)
             if identify:
                 link.identify()
             else:
@@ -143,14 +147,20 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
             link._signing = True
         return link
 
-    def _await_vehicle(self, target_system: int | None, wait_s: float, install_key: bool) -> None:
-        deadline = self._clock() + wait_s
+    def _await_vehicle(self, target_system: int | None, wait_s: float, install_key: bool,
+                       on_wait: Callable[[str], None] | None = None) -> None:
+        start = self._clock()
+        deadline = start + wait_s
         first: Any = None
         while first is None:
             now = self._clock()
+            if on_wait is not None and now >= start + WAIT_NOTICE_S:
+                on_wait(f"waiting for a vehicle heartbeat on {self.spec.url} "
+                        f"(up to {deadline - start:.0f} s)")
+                on_wait = None
             if now >= deadline:
                 whose = "vehicle" if target_system is None else f"vehicle {target_system}"
-                raise LinkError(
+                raise VehicleNotUp(
                     f"{self.spec.url}: no {whose} heartbeat within {wait_s:.1f} s ({self._heard()})"
                 )
             if now >= self._next_gcs_hb_s:
@@ -160,7 +170,7 @@ class VehicleLink(ArmingAndModes, ParamProtocol, Identification, StreamBringUp, 
                 self._ep.flush()
                 msgs = self._ep.receive()
             except TransportClosed:
-                raise LinkError(
+                raise VehicleNotUp(
                     f"{self.spec.url}: the peer closed the link before a vehicle heartbeat"
                 ) from None
             for msg in msgs:

@@ -76,6 +76,8 @@ class FlightPlan:
             raise ValueError(f"altitude {self.alt_m} m outside 0.2..3.5 m (the sonar's range)")
         if self.hold_s <= 0.0:
             raise ValueError(f"hold time must be > 0 s, got {self.hold_s}")
+        if not 0.0 < self.arm_timeout_s <= 600.0:
+            raise ValueError(f"arm timeout {self.arm_timeout_s} s outside 0..600 s")
         if self.takeoff_delay_s < 0.0:
             raise ValueError(f"take-off delay must be >= 0 s, got {self.takeoff_delay_s}")
         if self.step_m and self.step_observe_s <= self.step_smooth_s:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from firmware_link import DEFAULT_CONNECT_TIMEOUT_S
+from gcs.errors import UsageError
 from gcs.station.session import SessionOptions
 
 
@@ -13,6 +15,7 @@ def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--connect", metavar="URL",
                    help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
                         "default: start the bundled SITL")
+    add_connect_timeout_argument(p)
     p.add_argument("--mocap", metavar="URL", help="motion-capture endpoint (tcp:HOST:PORT)")
     p.add_argument("--profile", choices=("apm25", "copter4"), default="apm25",
                    help="firmware profile of the bundled SITL (default apm25)")
@@ -34,6 +37,23 @@ def add_vehicle_arguments(p: argparse.ArgumentParser) -> None:
                         "vehicle is refused")
     add_forward_argument(p)
     add_foxglove_argument(p)
+
+
+def add_connect_timeout_argument(p: argparse.ArgumentParser, default: object = None) -> None:
+    """--connect-timeout S: how long --connect waits for a vehicle that is not up yet."""
+    p.add_argument("--connect-timeout", metavar="S", type=float,
+                   default=DEFAULT_CONNECT_TIMEOUT_S if default is None else default,
+                   help="with --connect, wait this long for a vehicle that is not up yet "
+                        "(its TCP port refusing, its serial device absent, no heartbeat), "
+                        f"retrying (default {DEFAULT_CONNECT_TIMEOUT_S:g})")
+
+
+def connect_timeout(args: argparse.Namespace) -> float:
+    """The checked --connect-timeout."""
+    value = float(getattr(args, "connect_timeout", DEFAULT_CONNECT_TIMEOUT_S))
+    if not 0 < value <= 3600:
+        raise UsageError(f"--connect-timeout {value:g}: expected 0 < S <= 3600")
+    return value
 
 
 def add_forward_argument(p: argparse.ArgumentParser) -> None:
@@ -62,4 +82,5 @@ def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
         output=args.output, fix_failsafe=getattr(args, "fix_failsafe", False),
         foxglove=getattr(args, "foxglove", None),
         forward=tuple(getattr(args, "forward", None) or ()),
+        connect_timeout_s=connect_timeout(args),
     )

@@ -21,8 +21,7 @@ import socket
 import sys
 from typing import Any, Protocol, runtime_checkable
 
-from firmware_link import LinkError, parse_connection_string
-from firmware_link.records import Dialect
+from firmware_link import FirmwareInfo, LinkError, parse_connection_string
 from gcs.clock import Clock
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
 from gcs.errors import FlightFailed, UsageError
@@ -60,6 +59,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                         "same speed-up")
     p.add_argument("--takeoff-delay", type=float, default=0.0, metavar="S",
                    help="stay armed on the floor this long before taking off (default 0)")
+    p.add_argument("--arm-timeout", type=float, default=plan.arm_timeout_s, metavar="S",
+                   help="ask the vehicle to arm again, showing the firmware's refusal, until "
+                        f"this long after the first request (default {plan.arm_timeout_s:g}; "
+                        "4.x's pre-arm refuses for ~24 s after boot)")
     p.add_argument("--lockstep", action="store_true",
                    help="fly the bundled SITL in this process on simulated time, as fast as the "
                         "CPU allows and the same flight for the same --seed (no --connect)")
@@ -76,9 +79,10 @@ def _plan(args: argparse.Namespace) -> FlightPlan:
     try:
         return FlightPlan(alt_m=args.alt, hold_s=args.hold, step_m=args.step,
                           step_observe_s=args.step_watch, step_band_m=args.step_band,
-                          takeoff_delay_s=args.takeoff_delay)
+                          takeoff_delay_s=args.takeoff_delay, arm_timeout_s=args.arm_timeout)
     except ValueError as exc:
-        raise UsageError(f"--alt/--hold/--step/--step-watch/--step-band: {exc}") from None
+        raise UsageError(f"--alt/--hold/--step/--step-watch/--step-band/--arm-timeout: "
+                         f"{exc}") from None
 
 
 class LivePrinter:
@@ -114,7 +118,8 @@ def _metres(x: float) -> float | None:
     return round(x, 4) if math.isfinite(x) else None
 
 
-def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> dict[str, Any]:
+def _summary_dict(s: FlightSummary, recording: str | None,
+                  firmware: FirmwareInfo) -> dict[str, Any]:
     d: dict[str, Any] = {
         "rms_error_m": _metres(s.rms_error_m),
         "max_error_m": _metres(s.max_error_m),
@@ -132,7 +137,9 @@ def _summary_dict(s: FlightSummary, recording: str | None, dialect: Dialect) -> 
         "lost_messages": s.lost_messages,
         "corrupted_frames": s.corrupted,
         "hover_throttle": round(s.hover_throttle, 4),
-        "dialect": dialect.value,
+        "dialect": firmware.dialect.value,
+        "firmware": firmware.name,
+        "firmware_source": firmware.source,
         "recording": recording,
     }
     if s.estimator is not None:
@@ -167,6 +174,7 @@ def _print_summary(d: dict[str, Any]) -> None:
     print(f"loop: jitter p50 {d['jitter_p50_ms']:.3f} ms, p99 {d['jitter_p99_ms']:.3f} ms, "
           f"compute p99 {d['compute_p99_ms']:.3f} ms, overruns {d['overruns']} "
           f"of {d['ticks']} ticks")
+    print(f"firmware {d['firmware']} (identified by {d['firmware_source'] or 'nothing'})")
     print(f"link ({d['dialect']}): {d['rx_messages']} messages received, "
           f"{d['lost_messages']} lost, {d['corrupted_frames']} corrupted")
     if "estimator" in d:
@@ -247,7 +255,7 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
         snap = v.station.snapshot(loop_stats=False)
         raise FlightFailed(f"{exc}; link down {snap.link_down_s:.1f} s; recording "
                            f"{path or 'off'}") from None
-    d = _summary_dict(runner.summary(v.truth_series()), path, v.link.dialect)
+    d = _summary_dict(runner.summary(v.truth_series()), path, v.link.firmware)
     d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
     d["status"] = "ok"
     if session.forwarder is not None:

@@ -13,7 +13,12 @@ import argparse
 import sys
 from pathlib import Path
 
-from gcs.commands._vehicle_args import add_forward_argument, add_foxglove_argument
+from gcs.commands._vehicle_args import (
+    add_connect_timeout_argument,
+    add_forward_argument,
+    add_foxglove_argument,
+    connect_timeout,
+)
 from gcs.errors import MissionFailed, UsageError
 from gcs.mission.options import RunOptions
 from gcs.mission.runner import run_mission
@@ -30,6 +35,11 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     r.add_argument("--connect", metavar="URL",
                    help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
                         "default: start the bundled SITL with the mission's world")
+    add_connect_timeout_argument(r)
+    r.add_argument("--arm-timeout", type=float, metavar="S",
+                   help="ask each vehicle to arm again, showing its firmware's refusal, until "
+                        "this long after the first request (default: the file's "
+                        "flight.arm_timeout_s, else 30)")
     r.add_argument("--mocap", metavar="URL", help="motion-capture endpoint (tcp:HOST:PORT)")
     r.add_argument("--kinematic", action="store_true",
                    help="exact moves in the planners' kinematic world, no vehicle")
@@ -78,10 +88,14 @@ def run(args: argparse.Namespace) -> int:
     if args.lockstep and args.speedup is not None:
         raise UsageError("--lockstep: --speedup cannot be used with it (lockstep flies the "
                          "bundled SITL in this process on simulated time)")
+    if args.arm_timeout is not None and not 0 < args.arm_timeout <= 600:
+        raise UsageError(f"--arm-timeout {args.arm_timeout:g}: expected 0 < S <= 600")
     if args.speedup is not None and not 0 < args.speedup <= 50:
         raise UsageError(f"--speedup {args.speedup}: expected 0 < speedup <= 50")
     spec = load_mission(args.file)
     options = RunOptions(kinematic=args.kinematic, connect=args.connect, mocap=args.mocap,
+                         connect_timeout_s=connect_timeout(args),
+                         arm_timeout_s=args.arm_timeout,
                          record=args.record, output=args.output, plot=args.plot,
                          speedup=args.speedup, seed=args.seed, fix_failsafe=args.fix_failsafe,
                          foxglove=args.foxglove, forward=tuple(args.forward),

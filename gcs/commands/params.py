@@ -6,7 +6,9 @@ As pilots know it from MAVProxy and Mission Planner:
     quadgcs params get NAME
     quadgcs params set NAME VALUE      read back and confirmed; prints NAME old → new
     quadgcs params save FILE           a .parm file (NAME VALUE, sorted)
-    quadgcs params load FILE           sets what differs; reports changed / unchanged / failed
+    quadgcs params load FILE           sets what differs; reports changed / unchanged / failed;
+                                       a file with any line the vehicle cannot take (unknown
+                                       name, value its type cannot hold) is refused whole
     quadgcs params diff FILE           the parameters whose vehicle value differs from FILE
 
 With no `--connect` the bundled SITL is started (`--profile`, `--world`, `--serial`, `--seed`,
@@ -27,15 +29,18 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from firmware_link import (
+    DEFAULT_CONNECT_TIMEOUT_S,
     LinkUsageError,
     ParamError,
     VehicleLink,
     diff_params,
     format_param_value,
+    open_when_up,
     read_parm_file,
     write_parm_file,
 )
-from firmware_link.params import check_param_name
+from firmware_link.params import check_param_name, check_param_value
+from gcs.commands._vehicle_args import add_connect_timeout_argument, connect_timeout
 from gcs.errors import RuntimeFault, UsageError
 from gcs.sitl_process import SitlOptions, SitlProcess
 from gcs.toml_file import read_signing_key
@@ -58,6 +63,7 @@ def _add_vehicle_flags(p: argparse.ArgumentParser, *, on_action: bool) -> None:
     p.add_argument("--connect", metavar="URL", default=d(None),
                    help="vehicle link (tcp:HOST:PORT, udpin:..., /dev/ttyUSB0[,baud]); "
                         "default: start the bundled SITL")
+    add_connect_timeout_argument(p, d(DEFAULT_CONNECT_TIMEOUT_S))
     p.add_argument("--profile", choices=("apm25", "copter4"), default=d("apm25"),
                    help="firmware profile of the bundled SITL (default apm25)")
     p.add_argument("--world", type=Path, default=d(None), help="world TOML for the bundled SITL")
@@ -137,9 +143,11 @@ def _vehicle(args: argparse.Namespace) -> Iterator[VehicleLink]:
             endpoints = sitl.start()
             stack.callback(sitl.stop)
             url = endpoints.url(1, serial=args.serial)
+            link = stack.enter_context(VehicleLink.open(url, signing_key=key))
         else:
-            url = args.connect
-        link = stack.enter_context(VehicleLink.open(url, signing_key=key))
+            link = stack.enter_context(open_when_up(
+                args.connect, timeout_s=connect_timeout(args), signing_key=key,
+                on_wait=lambda line: print(line, file=sys.stderr, flush=True)))
         yield link
 
 
@@ -206,16 +214,48 @@ def _save(link: VehicleLink, path: Path) -> int:
     return 0
 
 
+def _refusals(link: VehicleLink, current: dict[str, float],
+              wanted: dict[str, float]) -> list[str]:
+    """Every line of the file the vehicle could not take, as `NAME VALUE: why`: a name it does
+    not have, a value its parameter's type cannot hold (not a whole number, out of range)."""
+    refused: list[str] = []
+    for name, value in wanted.items():
+        shown = format_param_value(value)
+        if name not in current:
+            hint = RENAMED.get(name)
+            refused.append(f"{name} {shown}: unknown name, not a parameter of this vehicle"
+                           + (f" (did you mean {hint}?)" if hint else ""))
+            continue
+        try:
+            check_param_value(name, value, link.param_type(name))
+        except LinkUsageError as exc:
+            refused.append(f"{name} {shown}: {_why(exc)}")
+    return refused
+
+
+def _why(exc: LinkUsageError) -> str:
+    """The reason of a value check, without the parameter name the line already starts with."""
+    text = str(exc)
+    _, sep, rest = text.partition(": ")
+    if sep and text.startswith("parameter "):
+        return f"out of range: {rest}" if "outside" in rest else f"wrong type: {rest}"
+    if "whole number" in text:
+        return "wrong type: the parameter is an integer, the value is not a whole number"
+    return text
+
+
 def _load(link: VehicleLink, path: Path, wanted: dict[str, float]) -> int:
     current = link.fetch_params()
+    # All or nothing: a half-applied file leaves the vehicle in a state no file describes.
+    refused = _refusals(link, current, wanted)
+    if refused:
+        for line in refused:
+            print(f"quadgcs params: load {path}: refused {line}", file=sys.stderr)
+        raise UsageError(f"load {path}: {len(refused)} of {len(wanted)} lines refused; "
+                         "nothing was written to the vehicle")
     changed = unchanged = 0
     failed: list[str] = []
     for name, value in wanted.items():
-        if name not in current:
-            hint = RENAMED.get(name)
-            failed.append(f"{name}: not a parameter of this vehicle"
-                          + (f" (did you mean {hint}?)" if hint else ""))
-            continue
         old = current[name]
         kind = link.param_type(name)
         if format_param_value(old, kind) == format_param_value(value, kind):
@@ -224,6 +264,7 @@ def _load(link: VehicleLink, path: Path, wanted: dict[str, float]) -> int:
         try:
             new = link.set_param(name, value)
         except (ParamError, LinkUsageError) as exc:
+            # the vehicle refused or changed a value its type allows (its own limits)
             failed.append(f"{name}: {exc}")
             continue
         changed += 1

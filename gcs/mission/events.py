@@ -20,6 +20,7 @@ class MissionEvent(enum.Enum):
 
     SESSION_READY = "session_ready"  # every vehicle's station is up and checked
     ARMING = "arming"
+    ARM_REFUSED = "arm_refused"  # a vehicle's firmware refused to arm (why): asked again
     ARMED = "armed"  # every vehicle armed, on the floor, throttle minimum
     DISARMED_ON_FLOOR = "disarmed_on_floor"  # the team took too long: disarmed before take-off
     TAKING_OFF = "taking_off"

@@ -53,6 +53,7 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
     sysids = tuple(v.sysid for v in spec.vehicles)
     session_options = SessionOptions(
         command="mission", connect=options.connect, mocap=options.mocap, profile=spec.profile,
+        connect_timeout_s=options.connect_timeout_s,
         world=spec.world_path, speedup=speedup, seed=options.seed, record=options.record,
         output=options.output, sysids=sysids, fix_failsafe=options.fix_failsafe,
         foxglove=options.foxglove,
@@ -91,6 +92,8 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         # the room's bounds are the planner's to know; the boxes in it only with the truth
         rec.scene(station_clock.now_s(), mw.world.room,
                   mw.world.obstacles if options.truth else ())
+        if options.arm_timeout_s is not None:
+            spec = dataclasses.replace(spec, arm_timeout_s=options.arm_timeout_s)
         f = Team(spec, crafts, rec, EventLog(rec, progress))
         f.event(MissionEvent.SESSION_READY, detail=f"{len(crafts)} vehicle(s)")
         try:

@@ -13,6 +13,8 @@ class RunOptions:
 
     kinematic: bool = False
     connect: str | None = None
+    connect_timeout_s: float = 30.0  # how long `connect` is waited for (firmware_link.wait_up)
+    arm_timeout_s: float | None = None  # None: the mission file's flight.arm_timeout_s
     mocap: str | None = None
     record: bool = True
     output: Path = Path("flights")

@@ -13,7 +13,8 @@ y east and altitude positive up (metres); they are turned into local NED here, o
                                                     world's start points)
     [flight]      takeoff_alt_m, land, max_duration_s, profile ("apm25" | "copter4"),
                   speedup (SITL and station clock), position_tolerance_m, settle_s,
-                  step_timeout_s (when a planner's set position counts as reached)
+                  step_timeout_s (when a planner's set position counts as reached),
+                  arm_timeout_s (each vehicle's arm asked again until then; default 30)
     [planner]     kind = "epbha" | "flocking" | "radiation", then the planner's parameters by
                   their field names, plus max_steps, seed, noise_sigma_m, max_samples,
                   floor_margin_m (see gcs.mission.planner_params)
@@ -32,6 +33,7 @@ from typing import Any
 
 from gcs.config import StationConfig, config_from_table
 from gcs.errors import UsageError
+from gcs.launch import ARM_TIMEOUT_S
 from worldfile import parse_toml
 
 Vec3 = tuple[float, float, float]
@@ -75,6 +77,7 @@ class MissionSpec:
     settle_s: float = 0.4  # ... for this long (station clock)
     step_timeout_s: float = 8.0  # a set position not reached by then counts as reached anyway
     station: StationConfig | None = None  # None: the station's defaults (or `--config`'s)
+    arm_timeout_s: float = ARM_TIMEOUT_S  # arms asked again until this after the request
 
     @property
     def goal_n(self) -> Vec3 | None:
@@ -186,6 +189,8 @@ def load_mission(path: str | Path) -> MissionSpec:
     settle_s = r.number(flight, "settle_s", "flight.settle_s", 0.4, positive=True)
     step_timeout_s = r.number(flight, "step_timeout_s", "flight.step_timeout_s", 8.0,
                               positive=True)
+    arm_timeout_s = r.number(flight, "arm_timeout_s", "flight.arm_timeout_s", ARM_TIMEOUT_S,
+                             positive=True)
 
     planner_table = data.get("planner")
     if not isinstance(planner_table, dict):
@@ -225,6 +230,7 @@ def load_mission(path: str | Path) -> MissionSpec:
         settle_s=settle_s,
         step_timeout_s=step_timeout_s,
         station=station,
+        arm_timeout_s=arm_timeout_s,
     )
 
 

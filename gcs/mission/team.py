@@ -12,7 +12,7 @@ import math
 
 from gcs.errors import RuntimeFault
 from gcs.landing import descend, hand_over, may_descend
-from gcs.launch import Launch, LaunchStage
+from gcs.launch import Launch, LaunchRules, LaunchStage
 from gcs.mission.craft import Craft, CraftPhase, go_to_all
 from gcs.mission.events import EventLog, MissionEvent
 from gcs.mission.off_mission import off_mission
@@ -27,6 +27,7 @@ DESCENT_MPS = 0.3
 DISARM_WAITS_S = (10.0, 10.0, 10.0, 10.0)  # in LAND, a disarm request after each
 POLL_S = 0.1
 STAGE_EVENTS = {LaunchStage.ARMING: MissionEvent.ARMING, LaunchStage.ARMED: MissionEvent.ARMED,
+                LaunchStage.ARM_REFUSED: MissionEvent.ARM_REFUSED,
                 LaunchStage.DISARMED: MissionEvent.DISARMED_ON_FLOOR}
 
 
@@ -47,7 +48,8 @@ class Team:
         self.armed_at_s: dict[int, float] = {}
         self.gone: dict[int, str] = {}  # vehicles the station no longer flies, and why
         self.port = _TeamPort(self)
-        self.launch = Launch({v: c.station for v, c in crafts.items()}, self.port)
+        self.launch = Launch({v: c.station for v, c in crafts.items()}, self.port,
+                             LaunchRules(arm_timeout_s=spec.arm_timeout_s))
 
     def event(self, what: MissionEvent, vehicle: int | None = None, detail: str = "") -> None:
         """Tell the pilot and the recording."""

@@ -15,6 +15,10 @@ class LinkView:
 
     url: str = ""
     dialect: str = ""
+    # the firmware as identified ("ArduCopter V4.7.0-dev") and by what ("AUTOPILOT_VERSION");
+    # empty: not known (a replay of an older recording), the dialect is shown instead
+    firmware: str = ""
+    firmware_source: str = ""
     connected: bool = False
     lost: bool = False
     heartbeat_age_s: float | None = None

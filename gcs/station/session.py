@@ -18,10 +18,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from firmware_link import (
+    DEFAULT_CONNECT_TIMEOUT_S,
     Forwarder,
     MocapLink,
     ParamError,
     VehicleLink,
+    open_when_up,
 )
 from firmware_link.records import Battery, Dialect, GpsFix, MocapPose
 from firmware_link.truth_link import TruthLink, TruthRecorder
@@ -75,6 +77,8 @@ class SessionOptions:
     fix_failsafe: bool = False  # the pilot's consent to set unsafe failsafe parameters
     foxglove: str | None = None  # [HOST:]PORT: serve the flight live to Foxglove
     forward: tuple[str, ...] = ()  # other ground stations' URLs (firmware_link.forward)
+    # how long `connect` is waited for when it is not up yet (firmware_link.wait_up)
+    connect_timeout_s: float = DEFAULT_CONNECT_TIMEOUT_S
 
     def validate(self) -> None:
         """Reject impossible combinations with one line each."""
@@ -84,6 +88,11 @@ class SessionOptions:
             raise UsageError(f"--world {self.world}: no such file")
         if self.connect is not None and len(self.sysids) > 1:
             raise UsageError("--connect flies one vehicle; several need the bundled SITL")
+
+
+def _tell(line: str) -> None:
+    """A waiting line for the pilot (before any screen is up)."""
+    print(line, file=sys.stderr, flush=True)
 
 
 class MocapFor:
@@ -265,9 +274,13 @@ class StationSession:
         # one vehicle takes every forwarded frame; several share them out by target system
         forward = (self.forwarder.port(sysid if len(o.sysids) > 1 else None)
                    if self.forwarder is not None else None)
-        link = VehicleLink.open(url, signing_key=key, clock=self.clock.now_s,
-                                target_system=sysid if o.connect is None else None,
-                                on_raw=sink.put_raw if sink is not None else None,
+        on_raw = sink.put_raw if sink is not None else None
+        if o.connect is None:  # the bundled SITL is up: its ports are open
+            link = VehicleLink.open(url, signing_key=key, clock=self.clock.now_s,
+                                    target_system=sysid, on_raw=on_raw, forward=forward)
+        else:  # a vehicle may still be booting: wait for it as other ground stations do
+            link = open_when_up(url, timeout_s=o.connect_timeout_s, on_wait=_tell,
+                                clock=self.clock.now_s, signing_key=key, on_raw=on_raw,
                                 forward=forward)
         stack.callback(link.close)
         link.bring_up(STREAM_RATE_HZ)

@@ -43,6 +43,7 @@ def _child(options: SessionOptions, conn: Connection) -> None:
                 v.station, url=v.url,
                 recording=str(v.recorder.path) if v.recorder is not None else None,
                 dialect=v.link.dialect.value, signing=v.link.signing, forward=v.link.forward,
+                firmware=v.link.firmware.name, firmware_source=v.link.firmware.source,
             )
             v.station.start()
             conn.send(("ready", backend.view()))
@@ -82,7 +83,10 @@ class ProcessBackend:
 
     live = True
 
-    def __init__(self, options: SessionOptions, start_timeout_s: float = START_TIMEOUT_S) -> None:
+    def __init__(self, options: SessionOptions, start_timeout_s: float | None = None) -> None:
+        if start_timeout_s is None:  # a vehicle not up yet is waited for first (--connect)
+            start_timeout_s = START_TIMEOUT_S + (options.connect_timeout_s
+                                                 if options.connect is not None else 0.0)
         ctx = mp.get_context("spawn")
         self._conn, child_conn = ctx.Pipe()
         self._proc = ctx.Process(target=_child, args=(options, child_conn), name="quadgcs-station",

@@ -33,11 +33,14 @@ class StationBackend:
 
     def __init__(self, station: Station, *, url: str = "", recording: str | None = None,
                  dialect: str = "", signing: bool = False,
-                 forward: ForwardPort | None = None) -> None:
+                 forward: ForwardPort | None = None, firmware: str = "",
+                 firmware_source: str = "") -> None:
         self.station = station
         self.url = url
         self.recording = recording
         self.dialect = dialect
+        self.firmware = firmware
+        self.firmware_source = firmware_source
         self.signing = signing
         self.forward = forward  # the forwarded stations' side of the link (None: no --forward)
         n = int(HISTORY_S / (station.config.period_s * HISTORY_EVERY_TICKS))
@@ -102,6 +105,8 @@ class StationBackend:
             link=LinkView(
                 url=self.url,
                 dialect=self.dialect,
+                firmware=self.firmware,
+                firmware_source=self.firmware_source,
                 connected=hb is not None,
                 lost=snap.link_lost,
                 heartbeat_age_s=snap.t_s - hb.t_s if hb is not None else None,

@@ -40,7 +40,10 @@ class LinkPanel(Panel):
         """Link and loop health."""
         link, loop = view.link, view.loop
         text = Text()
-        text.append(f"{link.url or '—'}  {link.dialect}\n")
+        text.append(f"{link.url or '—'}  {link.firmware or link.dialect}")
+        if link.firmware_source:
+            text.append(f" · {link.firmware_source}", style="dim")
+        text.append("\n")
         if link.lost:
             text.append("LINK LOST", style="bold red")
         elif link.connected:

@@ -152,6 +152,16 @@ def version_texts(profile: Profile, options: AutopilotOptions) -> list[tuple[int
     return [(int(Severity.INFO), version), (int(Severity.INFO), "Frame: QUAD/PLUS")]
 
 
+def autopilot_version(profile: Profile, options: AutopilotOptions) -> tuple[int, bytes] | None:
+    """(AUTOPILOT_VERSION.flight_sw_version, git hash) as 4.x reports them; None for 3.2.1,
+    which has no such reply (it refuses MAV_CMD_REQUEST_MESSAGE)."""
+    if profile is Profile.APM25:
+        return None
+    if options.pre_47_names:  # 4.6.2, an official release (FIRMWARE_VERSION_TYPE 255)
+        return (4 << 24) | (6 << 16) | (2 << 8) | 255, b""
+    return (4 << 24) | (7 << 16) | (0 << 8) | 0, b"d2e4299f"  # 4.7.0-dev (type 0)
+
+
 def apm25_arming_texts() -> list[tuple[float, int, str]]:
     """(seconds after the arm command, severity, text) of 3.2.1's blocking arming."""
     low, high = int(Apm25Severity.LOW), int(Apm25Severity.HIGH)

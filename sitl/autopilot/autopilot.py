@@ -233,6 +233,10 @@ class Autopilot(ModeRunner):
         """The texts the firmware sends on PARAM_REQUEST_LIST."""
         return arming.version_texts(self.profile, self.options)
 
+    def autopilot_version(self) -> tuple[int, bytes] | None:
+        """AUTOPILOT_VERSION's version number and git hash; None where there is none (3.2.1)."""
+        return arming.autopilot_version(self.profile, self.options)
+
     # ---- the main loop ---------------------------------------------------------------------
     def update(self, s: SensorSample, t_s: float, dt_s: float) -> MixerOutput:
         """One main-loop tick: estimate, check failsafes, run the mode, mix."""

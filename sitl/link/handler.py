@@ -33,6 +33,10 @@ from sitl.link.view import VehicleView
 MAV_CMD_DO_SET_MODE = 176
 MAV_CMD_COMPONENT_ARM_DISARM = 400
 MAV_CMD_SET_MESSAGE_INTERVAL = 511
+MAV_CMD_REQUEST_MESSAGE = 512
+MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES = 520
+AUTOPILOT_VERSION_ID = 148
+MAV_PROTOCOL_CAPABILITY_MAVLINK2 = 8192
 MAV_RESULT_ACCEPTED = 0
 MAV_RESULT_FAILED = 4
 MAV_RESULT_UNSUPPORTED = 3
@@ -210,6 +214,15 @@ class VehicleLink:
             name = entry.msgname if entry is not None else ""
             ok = ch.streams.set_interval(name, msg.param2)
             self._ack(ch, msg, cmd, ok)
+        elif (cmd == MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES or (
+                cmd == MAV_CMD_REQUEST_MESSAGE and int(msg.param1) == AUTOPILOT_VERSION_ID)) and (
+                (version := ap.autopilot_version()) is not None):
+            # 4.x answers both with its version number; 3.2.1 refuses both (below)
+            self._ack(ch, msg, cmd, True)
+            number, git = version
+            ch.send_reply(messages.MAVLink_autopilot_version_message(
+                MAV_PROTOCOL_CAPABILITY_MAVLINK2, number, 0, 0, 0, list(git.ljust(8, b"\0")),
+                [0] * 8, [0] * 8, 0, 0, 0))
         else:
             self._ack(ch, msg, cmd, False, MAV_RESULT_UNSUPPORTED)
 

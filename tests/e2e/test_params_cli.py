@@ -95,17 +95,31 @@ def test_names_the_vehicle_does_not_have(sitl: tuple[str, str]) -> None:
     one_line_error(quadgcs("--connect", url, "show", "NOPE*"), 1, "no parameter of vehicle 1")
 
 
-def test_load_reports_what_failed(sitl: tuple[str, str], tmp_path: Path) -> None:
+def test_load_refuses_a_file_with_any_bad_line_and_writes_none(
+        sitl: tuple[str, str], tmp_path: Path) -> None:
     _, url = sitl
-    angle = quadgcs("--connect", url, "get", "ANGLE_MAX").stdout.split()[1]
+    with VehicleLink.open(url) as link:
+        before = link.fetch_params()
+    angle = before["ANGLE_MAX"]
     parm = tmp_path / "partial.parm"
-    parm.write_text(f"ANGLE_MAX,{angle}\n" + "# one already so, two the vehicle does not have\n"
-                    "NOT_A_PARAM 1\nANGLE_MAX_X 1\n")
+    # a valid change first (the old load wrote it before meeting the bad lines), then an
+    # unknown name, a fraction for an integer and a value no 8-bit integer holds
+    parm.write_text(f"ANGLE_MAX,{format_param_value(angle - 500)}\n"
+                    "NOT_A_PARAM 1\nRC1_DZ 2.5\nFS_GCS_ENABLE 70000\n")
     proc = quadgcs("--connect", url, "load", str(parm))
-    assert proc.returncode == 1
-    assert proc.stdout.splitlines()[-1] == f"loaded {parm}: 0 changed, 1 unchanged, 2 failed of 3"
+    assert proc.returncode == 2, (proc.stdout, proc.stderr)
+    assert proc.stdout == ""
     errors = proc.stderr.strip().splitlines()
-    assert len(errors) == 2 and all("not a parameter of this vehicle" in e for e in errors)
+    assert errors[-1] == (f"quadgcs params: load {parm}: 3 of 4 lines refused; "
+                          "nothing was written to the vehicle")
+    refused = [e.removeprefix(f"quadgcs params: load {parm}: refused ") for e in errors[:-1]]
+    assert [r.split(":")[0] for r in refused] == [
+        "NOT_A_PARAM 1", "RC1_DZ 2.5", "FS_GCS_ENABLE 70000"], errors
+    assert "unknown name" in refused[0]
+    assert "wrong type" in refused[1] and "whole number" in refused[1]
+    assert "out of range" in refused[2]
+    with VehicleLink.open(url) as link:
+        assert link.fetch_params() == before  # read back: not one value changed
 
 
 def test_the_link_identifies_the_sitl(sitl: tuple[str, str]) -> None:
@@ -126,7 +140,8 @@ def test_the_link_identifies_the_sitl(sitl: tuple[str, str]) -> None:
         (["--connect", "tcp:127.0.0.1:1", "set", "ANGLE_MAX", "inf"], 2, "not a finite number"),
         (["load", "no/such/file.parm"], 2, "no/such/file.parm: no such file"),
         (["save", "no/such/dir/x.parm"], 2, "no such directory"),
-        (["--connect", "tcp:127.0.0.1:1", "show"], 1, "connection refused"),
+        (["--connect", "tcp:127.0.0.1:1", "--connect-timeout", "0.3", "show"], 1,
+         "connection refused"),
         (["--connect", "bogus::url", "show"], 2, "bogus"),
         ([], 2, "expected an action"),
     ],

@@ -50,6 +50,8 @@ def test_autopilot_version_is_trusted_first() -> None:
     assert info.gcs_sysid_param == "MAV_GCS_SYSID"
     assert info.version_number == (4, 7, 0)
     assert any("AUTOPILOT_VERSION" in e and "d2e4299f" in e for e in info.evidence)
+    assert info.source == "AUTOPILOT_VERSION"
+    assert info.label == "ArduCopter V4.7.0-dev (AUTOPILOT_VERSION)"
 
 
 def test_a_321_is_told_by_its_parameters_and_banner() -> None:
@@ -63,6 +65,8 @@ def test_a_321_is_told_by_its_parameters_and_banner() -> None:
     text = " | ".join(info.evidence)
     assert "THR_MID exists" in text and "not answered" in text and "'ArduCopter V3.2.1'" in text
     assert info.summary.startswith("ArduCopter V3.2.1: dialect APM25, MAVLink 1")
+    assert info.source == "STATUSTEXT banner"
+    assert info.summary.endswith("identified by STATUSTEXT banner")
 
 
 def test_a_4x_on_a_mavlink1_port_is_not_an_apm25() -> None:
@@ -70,6 +74,7 @@ def test_a_4x_on_a_mavlink1_port_is_not_an_apm25() -> None:
                                     version_refused=True))
     assert info.dialect is Dialect.COPTER4 and info.wire is WireVersion.V1
     assert info.version == "" and info.name == "ArduCopter 4.x"
+    assert info.label == "ArduCopter 4.x (parameters: MOT_THST_HOVER)"
     assert any("not an APM 2.5" in e for e in info.evidence)
 
 
@@ -78,6 +83,7 @@ def test_the_wire_alone_is_only_a_hint() -> None:
     assert info.dialect is Dialect.APM25
     assert any("only the wire version" in e and "hint" in e for e in info.evidence)
     assert any("assumed" in e for e in info.evidence)  # no GCS-id parameter was read
+    assert info.label == "ArduCopter 3.x (heartbeat only: MAVLink 1 frames)"
     assert decide_firmware(evidence(V2_FRAME)).dialect is Dialect.COPTER4
 
 

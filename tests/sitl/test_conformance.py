@@ -19,6 +19,7 @@ pytestmark = pytest.mark.e2e
 ROOT = Path(__file__).resolve().parents[2]
 SPEEDUP = 3.0
 ARM = 400
+REQUEST_MESSAGE = 512
 DO_SET_MODE = 176
 SET_MODE_ID = 11
 # REQUEST_DATA_STREAM(ALL) in the fixture tlogs (SIMSTATE: the SITL sends SIM_STATE instead)
@@ -121,6 +122,17 @@ def _probe(p: Probe, apm25: bool) -> None:
         assert "Arm: Accels inconsistent" in p.texts_since(n_texts)
     hb = p.wait(lambda m: m.get_type() == "HEARTBEAT" and m.base_mode == 81, 4.0, "standby")
     assert (hb.type, hb.autopilot, hb.base_mode, hb.custom_mode) == (2, 3, 81, 0)
+
+    # -- AUTOPILOT_VERSION: 4.x answers MAV_CMD_REQUEST_MESSAGE(148); 3.2.1 has no such reply --
+    st.command(REQUEST_MESSAGE, 148.0)
+    ack = p.ack(REQUEST_MESSAGE)
+    if apm25:
+        assert ack.result == 3  # UNSUPPORTED: its version only in the parameter list's banner
+    else:
+        assert ack.result == 0
+        av = p.wait(lambda m: m.get_type() == "AUTOPILOT_VERSION", 2.0, "AUTOPILOT_VERSION")
+        assert av.flight_sw_version == 0x04070000  # 4.7.0, FIRMWARE_VERSION_TYPE_DEV
+        assert bytes(av.flight_custom_version).rstrip(b"\0") == b"d2e4299f"
 
     # -- the parameter list ---------------------------------------------------------------
     st.conn.mav.param_request_list_send(1, 1, force_mavlink1=apm25)
