@@ -91,9 +91,17 @@ def onboard_hold(profile: str, seed: int, alt_m: float, hold_s: float) -> dict[s
         runner.phase = Phase.SETTLE
         runner.pause(4.0)
         runner.phase = Phase.DONE  # from here the PC flies nothing
-        st.set_sticks(1500, 1500, 1500, 1500)
         st.alt_hold(False)
+        runner.pause(0.1)
+        # the pilot's stick meets the throttle the hold left (the supervisor's gate), then
+        # centres: mid-stick is "hold this height"
+        held = st.snapshot(loop_stats=False).command.throttle_us
+        st.set_sticks(1500, 1500, 1500, held)
+        runner.pause(0.1)
+        st.set_sticks(1500, 1500, 1500, 1500)
         runner.pause(2.0)
+        if st.snapshot(loop_stats=False).command.throttle_us != 1500:
+            raise RuntimeError("the sticks did not centre")
         t0 = st.clock.now_s()
         runner.pause(hold_s)
         t1 = st.clock.now_s()

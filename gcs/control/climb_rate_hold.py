@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from firmware_link.records import Dialect
 from gcs.control.climb_stick import ClimbStickMap
 from gcs.estimation import AltEstimate
 
@@ -46,10 +47,16 @@ class ClimbRateHoldParams:
     # below this height the estimate cannot see the vehicle rise
     blind_alt_m: float = 0.35
     blind_margin_m: float = 0.4
+    # How far behind its climb-rate target the firmware's vehicle runs (s), so how far it goes
+    # on once the stick centres: 3.2.1 has no velocity feed-forward (from 1.72 m/s it travelled
+    # 1.67 m more, fixtures' althold-steps), 4.x feeds the rate forward and brakes in its
+    # shaping (1.5 m from 1.88 m/s, most of it at the full rate; much less from a slow climb)
+    lag_apm25_s: float = 1.0
+    lag_copter4_s: float = 0.5
 
     def __post_init__(self) -> None:
         for name in ("kp", "decel_mps2", "speed_mps", "accel_mps2", "band_m", "blind_up_mps",
-                     "blind_margin_m"):
+                     "blind_margin_m", "lag_apm25_s", "lag_copter4_s"):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
 
@@ -83,12 +90,18 @@ class ClimbRateHold:
     def __init__(self, params: ClimbRateHoldParams, stick: ClimbStickMap) -> None:
         self.params = params
         self.stick = stick
+        self.lag_s = (params.lag_copter4_s if stick.dialect is Dialect.COPTER4
+                      else params.lag_apm25_s)
         self.rate_mps = 0.0  # the rate asked last tick (the ramp starts from it)
+        # the vehicle's climb as the firmware follows the rates flown (a lag of lag_s): from
+        # the commands, not the estimate, so no sonar noise in it
+        self.model_vel_mps = 0.0
         self.open_loop_m = 0.0  # climb asked while the estimate was blind
 
-    def engage(self, rate_mps: float = 0.0) -> None:
-        """Start from `rate_mps` (a take-off from the floor: 0)."""
+    def engage(self, rate_mps: float = 0.0, vel_mps: float = 0.0) -> None:
+        """Start from `rate_mps` with the vehicle climbing at `vel_mps` (from the floor: 0)."""
         self.rate_mps = rate_mps
+        self.model_vel_mps = vel_mps
         self.open_loop_m = 0.0
 
     @property
@@ -104,13 +117,16 @@ class ClimbRateHold:
         p = self.params
         alt = estimate.alt_m if estimate.control_alt_m is None else estimate.control_alt_m
         error = target_m - alt
+        # where the vehicle would stop, centred now: the loop aims that at the target, so a
+        # climb tapers before the lag would carry it past
+        ahead = self.model_vel_mps * self.lag_s
         speed = p.speed_mps if speed_mps is None else speed_mps
         up = min(speed, self.stick.max_up_mps)
         down = min(speed, self.stick.max_down_mps)
         if blind and error > 0.0:
             want = up if not self.blind_exhausted else 0.0
         else:
-            want = sqrt_shape(error, p.kp, p.decel_mps2)
+            want = sqrt_shape(error - ahead, p.kp, p.decel_mps2)
             if abs(error) < p.band_m:
                 up = min(up, p.blind_up_mps)
             want = min(up, max(-down, want))
@@ -125,7 +141,9 @@ class ClimbRateHold:
             step = p.accel_mps2 * dt_s
             rate = prev + min(step, max(-step, want - prev))
         self.rate_mps = rate
+        thr = self.stick.stick_us(rate)
+        flown = self.stick.rate_mps(thr)
+        self.model_vel_mps += dt_s / (self.lag_s + dt_s) * (flown - self.model_vel_mps)
         if blind:
             self.open_loop_m += max(rate, 0.0) * dt_s
-        thr = self.stick.stick_us(rate)
-        return ClimbRateOutput(target_m, alt, error, rate, self.stick.rate_mps(thr), thr, blind)
+        return ClimbRateOutput(target_m, alt, error, rate, flown, thr, blind)
