@@ -7,13 +7,16 @@ the last override flown blind keeps accelerating the vehicle until the firmware'
 station's estimate (the same sonar/accelerometer fusion) and this loop ask for a climb rate
 instead, through `climb_stick.ClimbStickMap`:
 
-    rate = sqrt_shape(target − alt, kp, decel), within ±speed
+    rate = sqrt_shape(target − (alt + lag·v), kp, decel), within ±speed
 
 ArduPilot's own position → velocity shape (linear near the target, a constant deceleration
 beyond), so a move or a take-off tapers to zero at the set point and the firmware's velocity
-loop does the climbing. Steady (within `band_m`), the rate asked up is at most `blind_up_mps`:
-flown blind for 3.2.1's 5 s before its GCS failsafe that is 0.2 m, under the 0.3 m bound; small
-errors ask rates the firmware rounds to zero, so a steady hold sits at mid-stick.
+loop does the climbing; `lag·v` is how far the vehicle goes on once the stick centres (v: the
+rates flown, through the firmware's lag), so the taper ends where the vehicle stops. Once the
+hold has reached its target, it asks no climb that, flown blind until the firmware's failsafe
+(3.2.1: 5 s; 4.x: FS_GCS_TIMEOUT, at most 3 s), would end more than `blind_room_m` (0.15 m) over
+the target: 0.03 m/s at the set point on 3.2.1. Small errors ask rates the firmware rounds to
+zero, so a steady hold sits at mid-stick.
 
 Take-off: the estimate is blind below the rangefinder's minimum range (0.2 m on both
 firmwares), so there the loop does not close on it: the rate is the move's own, ramped up at
@@ -37,12 +40,18 @@ from gcs.estimation import AltEstimate
 class ClimbRateHoldParams:
     """Tuning of the climb-rate loop (SI units)."""
 
-    kp: float = 1.0  # s⁻¹: climb rate per metre of error near the target
+    kp: float = 3.0  # s⁻¹: climb rate per metre of error near the target
     decel_mps2: float = 0.4  # the taper's deceleration beyond the linear region
     speed_mps: float = 0.5  # a move's climb or sink rate when the request gives none
     accel_mps2: float = 1.0  # how fast the rate asked may change
-    band_m: float = 0.1  # within this of the target the hold is steady ...
-    blind_up_mps: float = 0.04  # ... and asks at most this climb (blind 5 s: 0.2 m)
+    # Once within band_m of its target, the hold asks no climb that, flown blind until the
+    # firmware's failsafe acts, would end more than blind_room_m over the target: 3.2.1's
+    # fixed 5 s, 4.x's FS_GCS_TIMEOUT (the pre-flight's 2 s, at most RC_OVERRIDE_TIME's 3 s).
+    # The rest of the issue's 0.3 m is the firmware's braking and the estimate's error.
+    band_m: float = 0.1
+    blind_room_m: float = 0.15
+    blind_apm25_s: float = 5.0
+    blind_copter4_s: float = 3.0
     # the rangefinder's minimum range (0.2 m) above the sonar's rest height, with a margin:
     # below this height the estimate cannot see the vehicle rise
     blind_alt_m: float = 0.35
@@ -55,7 +64,8 @@ class ClimbRateHoldParams:
     lag_copter4_s: float = 0.5
 
     def __post_init__(self) -> None:
-        for name in ("kp", "decel_mps2", "speed_mps", "accel_mps2", "band_m", "blind_up_mps",
+        for name in ("kp", "decel_mps2", "speed_mps", "accel_mps2", "band_m", "blind_room_m",
+                     "blind_apm25_s", "blind_copter4_s",
                      "blind_margin_m", "lag_apm25_s", "lag_copter4_s"):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
@@ -90,8 +100,11 @@ class ClimbRateHold:
     def __init__(self, params: ClimbRateHoldParams, stick: ClimbStickMap) -> None:
         self.params = params
         self.stick = stick
-        self.lag_s = (params.lag_copter4_s if stick.dialect is Dialect.COPTER4
-                      else params.lag_apm25_s)
+        c4 = stick.dialect is Dialect.COPTER4
+        self.lag_s = params.lag_copter4_s if c4 else params.lag_apm25_s
+        self.blind_s = params.blind_copter4_s if c4 else params.blind_apm25_s
+        self._target_m: float | None = None
+        self._arrived = False  # within band_m of the current target once
         self.rate_mps = 0.0  # the rate asked last tick (the ramp starts from it)
         # the vehicle's climb as the firmware follows the rates flown (a lag of lag_s): from
         # the commands, not the estimate, so no sonar noise in it
@@ -103,6 +116,8 @@ class ClimbRateHold:
         self.rate_mps = rate_mps
         self.model_vel_mps = vel_mps
         self.open_loop_m = 0.0
+        self._target_m = None
+        self._arrived = False
 
     @property
     def blind_exhausted(self) -> bool:
@@ -120,6 +135,10 @@ class ClimbRateHold:
         # where the vehicle would stop, centred now: the loop aims that at the target, so a
         # climb tapers before the lag would carry it past
         ahead = self.model_vel_mps * self.lag_s
+        if target_m != self._target_m:  # a move (take-off, step, descent): not yet arrived
+            self._target_m, self._arrived = target_m, False
+        if abs(error) < p.band_m:
+            self._arrived = True
         speed = p.speed_mps if speed_mps is None else speed_mps
         up = min(speed, self.stick.max_up_mps)
         down = min(speed, self.stick.max_down_mps)
@@ -127,8 +146,8 @@ class ClimbRateHold:
             want = up if not self.blind_exhausted else 0.0
         else:
             want = sqrt_shape(error - ahead, p.kp, p.decel_mps2)
-            if abs(error) < p.band_m:
-                up = min(up, p.blind_up_mps)
+            if self._arrived:
+                up = min(up, max(0.0, (p.blind_room_m + error) / self.blind_s))
             want = min(up, max(-down, want))
         # speeding up is ramped; slowing down or turning back is not (the firmware brakes a
         # rate by its own shaping, and a late stop overshoots)

@@ -86,12 +86,12 @@ def _holding(profile: str, faults: dict[str, Any] | None = None,
         yield st, watch
 
 
-def _fade_outcome(watch: Watch, fade_at: float) -> tuple[float, float, float]:
-    """Rise over the height at the fade's start, fastest sink within 0.3 m of the floor while
-    armed, and when it disarmed (from the fade's start)."""
+def _fade_outcome(watch: Watch, fade_at: float, hold_m: float = 1.0) -> tuple[float, float, float]:
+    """Rise over the hold (its set point: the SITL's own ALT_HOLD wanders 13-17 cm std about
+    it, the real firmware's 0.1 cm), fastest sink within 0.3 m of the floor while armed, and
+    when it disarmed (from the fade's start)."""
     rows = watch.after(fade_at)
-    h0 = rows[0][1]
-    rise = max(h for _, h, _, _, _ in rows) - h0
+    rise = max(h for _, h, _, _, _ in rows) - hold_m
     touchdown = max((-vz for _, h, vz, armed, _ in rows if armed and h < 0.3), default=0.0)
     off = [t for t, _, _, armed, _ in rows if not armed]
     return rise, touchdown, (off[0] - fade_at) if off else float("inf")
@@ -165,12 +165,11 @@ def test_quit_from_alt_hold_lands_and_stays_until_disarmed() -> None:
     nothing lifts it again once the station has gone."""
     with _holding("apm25") as (st, watch):
         t_quit = watch.rows[-1][0]
-        h0 = watch.rows[-1][1]
         st.stop()
         assert st.snapshot(loop_stats=False).state is SupervisorState.RELEASED
         gone = watch.rows[-1]
         assert not gone[3] and gone[1] < 0.1 and gone[0] - t_quit <= 20.0
-        assert max(h for _, h, _, _, _ in watch.after(t_quit)) <= h0 + RISE_MAX_M
+        assert max(h for _, h, _, _, _ in watch.after(t_quit)) <= 1.0 + RISE_MAX_M
 
 
 def test_downlink_lost_holds_mid_stick_then_lands() -> None:
