@@ -5,8 +5,10 @@ from __future__ import annotations
 import pytest
 
 from firmware_link.records import Dialect
+from gcs.config import HoldMode, config_from_table
 from gcs.control.climb_rate_hold import ClimbRateHold, ClimbRateHoldParams, sqrt_shape
 from gcs.control.climb_stick import ClimbStickMap
+from gcs.errors import UsageError
 from gcs.estimation import AltEstimate, SonarStatus
 from sitl.autopilot.pilot_climb import climb_rate_apm25, climb_rate_copter4
 
@@ -75,3 +77,12 @@ def test_taper_reaches_zero_at_the_target() -> None:
     assert sqrt_shape(0.0, 1.0, 0.4) == 0.0
     assert sqrt_shape(1.0, 1.0, 0.4) == pytest.approx((2 * 0.4 * (1.0 - 0.2)) ** 0.5)
     assert sqrt_shape(-0.1, 1.0, 0.4) == pytest.approx(-0.1)
+
+
+def test_station_toml_chooses_the_hold_mode_and_names_a_bad_one() -> None:
+    assert config_from_table({}).hold_mode is HoldMode.THROTTLE
+    cfg = config_from_table({"hold_mode": "climb-rate", "climb": {"kp": 2.0}})
+    assert cfg.hold_mode is HoldMode.CLIMB_RATE and cfg.climb.kp == 2.0
+    with pytest.raises(UsageError, match=r"station.toml: hold_mode: expected one of "
+                       r"\['throttle', 'climb-rate'\], got 'alt-hold'"):
+        config_from_table({"hold_mode": "alt-hold"}, "station.toml: ")

@@ -12,8 +12,12 @@ touch-down faster than 1.0 m/s, disarmed within 20 s.
 from __future__ import annotations
 
 import dataclasses
+import json
+import subprocess
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -26,6 +30,7 @@ from sitl.autopilot import AutopilotOptions, FlightMode
 from sitl.autopilot.profile import RcInput
 from sitl.world import default_world
 
+ROOT = Path(__file__).resolve().parents[2]
 CLIMB = dataclasses.replace(StationConfig(), hold_mode=HoldMode.CLIMB_RATE)
 FADE_AT_S = 45.0
 RISE_MAX_M = 0.3
@@ -188,3 +193,13 @@ def test_downlink_lost_holds_mid_stick_then_lands() -> None:
         rise, touchdown, disarm_s = _fade_outcome(watch, fade_at)
         assert rise <= RISE_MAX_M and touchdown <= TOUCHDOWN_MAX_MPS, (rise, touchdown)
         assert disarm_s <= DISARM_WITHIN_S, disarm_s
+
+
+def test_fly_flag_chooses_the_climb_rate_hold_and_the_summary_says_so() -> None:
+    done = subprocess.run([sys.executable, "-m", "lab", "fly", "--lockstep", "--hold", "2",
+                           "--hold-mode", "climb-rate", "--no-record", "--json"],
+                          cwd=ROOT, capture_output=True, text=True, timeout=300, check=False)
+    assert done.returncode == 0, done.stderr
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    assert summary["status"] == "ok" and summary["hold_mode"] == "climb-rate"
+    assert summary["error_source"] == "truth" and summary["rms_error_m"] < 0.3
