@@ -31,6 +31,8 @@ from typing import Any
 
 from firmware_link.records import FlightMode
 from gcs.config import HoldMode, StationConfig
+from gcs.control.attitude import yaw_from_quat
+from gcs.control.position_controller import PositionSetpoint
 from gcs.flight import FlightPlan, FlightRunner, Phase
 from gcs.lockstep_session import LockstepSession
 from gcs.scoring import score_hold
@@ -143,6 +145,7 @@ def fade(profile: str, seed: int, mode: HoldMode, way: str, alt_m: float = 1.0) 
             if clock.now_s() > 60.0:
                 return {"error": "did not arm"}
         st.alt_hold(True, alt_m, rate_mps=0.5)
+        _hold_position(st)
         while clock.now_s() < FADE_AT_S + FADE_S + 25.0:
             st.run_tick()
     at = [r for r in rows if r[0] >= FADE_AT_S]
@@ -153,6 +156,15 @@ def fade(profile: str, seed: int, mode: HoldMode, way: str, alt_m: float = 1.0) 
     off = [t for t, *_, armed in at if not armed]
     return {"rise": max(h for _, h, _, _ in at) - alt_m, "touchdown": max(low, default=0.0),
             "disarm_s": off[0] - FADE_AT_S if off else math.inf, "h0": h0}
+
+
+def _hold_position(st: Any) -> None:
+    """Hold the take-off spot and heading on motion capture, as `fly` does: without it the
+    vehicle drifts on its attitude noise and may land on the edge of the room's box."""
+    pose = st.snapshot(loop_stats=False).mocap
+    if pose is not None:
+        n, e, _ = pose.pos_n
+        st.set_position_setpoint(PositionSetpoint(n, e, yaw_from_quat(pose.q_nb)))
 
 
 def _stats(values: list[float]) -> str:

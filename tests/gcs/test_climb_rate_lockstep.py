@@ -23,6 +23,8 @@ from typing import Any
 import pytest
 
 from gcs.config import HoldMode, StationConfig
+from gcs.control.attitude import yaw_from_quat
+from gcs.control.position_controller import PositionSetpoint
 from gcs.lockstep_session import LockstepSession
 from gcs.station.session import SessionOptions
 from gcs.supervisor import SupervisorState
@@ -83,6 +85,10 @@ def _holding(profile: str, faults: dict[str, Any] | None = None,
                 break
         assert st.snapshot(loop_stats=False).state is SupervisorState.MANUAL
         st.alt_hold(True, 1.0, rate_mps=0.5)
+        pose = st.snapshot(loop_stats=False).mocap  # the take-off spot, held as `fly` does
+        assert pose is not None
+        st.set_position_setpoint(PositionSetpoint(pose.pos_n[0], pose.pos_n[1],
+                                                  yaw_from_quat(pose.q_nb)))
         _ticks(st, 16.0)
         snap = st.snapshot(loop_stats=False)
         assert snap.state is SupervisorState.HOLD, snap.state
