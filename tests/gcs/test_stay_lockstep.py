@@ -132,7 +132,8 @@ def test_climb_rate_hold_link_lost_both_ways_rises_little_lands_and_stays_down(
 
 @pytest.mark.xfail(strict=True, reason=(
     "#32: the direct-throttle hold (still the default; the climb-rate hold passes above) is not "
-    "safe blind: on the SITL's 3.2.1 sonar (6 cm steps) the direct-throttle hold of seed 3 swings 1420-1680 us, and the last override before the fade "
+    "safe blind: on the SITL's 3.2.1 sonar (6 cm steps) seed 3's hold swings 1420-1680 us, "
+    "and the last override before the fade "
     "(~+60 us over hover) carries the vehicle to 18 m in the 5 s before the GCS failsafe's "
     "LAND, which then needs 36 s at 0.5 m/s (the real 3.2.1: a last 1415 us took it to 6.2 m)"))
 @pytest.mark.parametrize("vehicle", list(VEHICLES))
