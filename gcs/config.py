@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from gcs.control.altitude_controller import AltitudeControllerParams
+from gcs.control.climb_rate_hold import ClimbRateHoldParams
 from gcs.control.position_controller import PositionControllerParams
 from gcs.errors import UsageError
 from gcs.estimation import EstimatorParams
@@ -40,6 +41,13 @@ class EstimatorKind(enum.Enum):
     KALMAN = "kalman"
     COMPLEMENTARY = "complementary"
     DEAD_RECKONING = "dead_reckoning"
+
+
+class HoldMode(enum.Enum):
+    """How the PC flies the altitude hold (gcs.supervisor.climb_mode)."""
+
+    THROTTLE = "throttle"  # STABILIZE, the PID's acceleration as a direct throttle (thesis ch. 7)
+    CLIMB_RATE = "climb-rate"  # the firmware's ALT_HOLD, the loop asking a climb rate
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,6 +76,8 @@ class StationConfig:
         default_factory=lambda: EstimatorParams(sonar_offset_m=0.05, rest_alt_m=0.06)
     )
     altitude: AltitudeControllerParams = field(default_factory=AltitudeControllerParams)
+    hold_mode: HoldMode = HoldMode.THROTTLE
+    climb: ClimbRateHoldParams = field(default_factory=ClimbRateHoldParams)
     position: PositionControllerParams = field(default_factory=PositionControllerParams)
     flight: FlightProfile = field(default_factory=FlightProfile)
     events_kept: int = 200

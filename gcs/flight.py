@@ -13,6 +13,7 @@ import time
 from collections.abc import Callable
 
 from firmware_link.records import FlightMode
+from gcs.config import HoldMode
 from gcs.control.attitude import yaw_from_quat
 from gcs.control.position_controller import PositionSetpoint
 from gcs.errors import FlightFailed
@@ -97,6 +98,8 @@ class FlightRunner:
         # modes the vehicle may be in while armed; anything else (a failsafe LAND, say) ends
         # the flight with a clear message instead of scoring a flight nobody is flying
         self.expected_modes: set[int] = {FlightMode.STABILIZE}
+        if station.config.hold_mode is HoldMode.CLIMB_RATE:
+            self.expected_modes.add(FlightMode.ALT_HOLD)  # the climb-rate hold flies in it
         station.add_listener(self._sample)
         self.port = _FlyPort(self)
         self.launch = Launch({sysid: station}, self.port,
@@ -210,8 +213,11 @@ class FlightRunner:
         if may_descend(snap):
             top = snap.estimate.alt_m if snap.estimate is not None else p.alt_m
             timeout_s = top / p.descent_mps + 15.0
-            if not descend(st, self.port, self.sysid, p.descent_mps, timeout_s,
-                           p.handover_alt_m):
+            handover = p.handover_alt_m
+            if st.config.hold_mode is HoldMode.CLIMB_RATE:
+                # below the rangefinder's blind band the estimate does not see the descent
+                handover = max(handover, st.config.climb.blind_alt_m)
+            if not descend(st, self.port, self.sysid, p.descent_mps, timeout_s, handover):
                 raise FlightFailed(f"descent did not happen within {timeout_s:g} s "
                                    f"({self._why(st.snapshot(loop_stats=False))})")
         self.expected_modes.add(FlightMode.LAND)

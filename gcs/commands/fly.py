@@ -24,6 +24,7 @@ from typing import Any, Protocol, runtime_checkable
 from firmware_link import FirmwareInfo, LinkError, parse_connection_string
 from gcs.clock import Clock
 from gcs.commands._vehicle_args import add_vehicle_arguments, session_options
+from gcs.config import HoldMode, load_config
 from gcs.errors import FlightFailed, UsageError
 from gcs.flight import FlightPlan, FlightRunner, FlightSummary, Phase
 from gcs.station.session import StationSession
@@ -66,6 +67,11 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.add_argument("--lockstep", action="store_true",
                    help="fly the bundled SITL in this process on simulated time, as fast as the "
                         "CPU allows and the same flight for the same --seed (no --connect)")
+    p.add_argument("--hold-mode", choices=[m.value for m in HoldMode], default=None,
+                   help="climb-rate: the PC asks climb rates of the vehicle's ALT_HOLD (the last "
+                   "override flown blind holds the height); throttle: the PC's PID flies the "
+                   "throttle in STABILIZE (thesis ch. 7). Default: the --config file's "
+                   "hold_mode, else throttle")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--live", action="store_true", help="print telemetry lines while flying")
     p.set_defaults(func=run)
@@ -184,6 +190,8 @@ def _print_summary(d: dict[str, Any]) -> None:
               f"stamped ahead of the station's clock; {e['late_bursts']} late bursts "
               "integrated at their own times")
     print(f"learned hover throttle {d['hover_throttle']:.3f}")
+    if "hold_mode" in d:
+        print(f"hold mode: {d['hold_mode']}")
     if "forward" in d:
         f = d["forward"]
         print(f"forward {', '.join(f['endpoints'])}: {f['to_stations']} frames out, "
@@ -221,12 +229,15 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError("--speedup applies to a simulator on this machine only (loopback or a "
                          "pseudo-terminal); a vehicle at --connect flies in real time")
     options = session_options(args, "fly")
+    config = load_config(options.config)
+    if getattr(args, "hold_mode", None) is not None:
+        config = dataclasses.replace(config, hold_mode=HoldMode(args.hold_mode))
     if getattr(args, "lockstep", False):
         from gcs.lockstep_session import LockstepSession
 
-        session: StationSession = LockstepSession(options)
+        session: StationSession = LockstepSession(options, config=config)
     else:
-        session = StationSession(options)
+        session = StationSession(options, config=config)
     with session:
         return fly_session(session, plan, live=args.live)
 
@@ -257,6 +268,7 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
                            f"{path or 'off'}") from None
     d = _summary_dict(runner.summary(v.truth_series()), path, v.link.firmware)
     d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
+    d["hold_mode"] = v.station.config.hold_mode.value
     d["status"] = "ok"
     if session.forwarder is not None:
         d["forward"] = dataclasses.asdict(session.forwarder.stats)

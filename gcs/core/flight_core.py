@@ -7,11 +7,13 @@ same outputs.
 
 from __future__ import annotations
 
-from firmware_link.records import Attitude, MocapPose
-from gcs.config import StationConfig
+from firmware_link.records import Attitude, Dialect, MocapPose
+from gcs.config import HoldMode, StationConfig
 from gcs.control.altitude_controller import AltitudeController
+from gcs.control.climb_rate_hold import ClimbRateHold
+from gcs.control.climb_stick import ClimbStickMap
 from gcs.control.position_controller import PositionController
-from gcs.control.throttle_curve import ThrottleCurve
+from gcs.control.throttle_curve import CurveKind, ThrottleCurve
 from gcs.core.inputs import TickInputs
 from gcs.core.landing import lands_on_death, may_leave, must_land
 from gcs.core.link_down import LinkDownClock
@@ -30,7 +32,10 @@ class FlightCore:
     """Owns the estimator, the controllers, the supervisor and the station's tick rules."""
 
     def __init__(self, config: StationConfig, curve: ThrottleCurve,
-                 hover_throttle: float | None, supervisor: SupervisorParams) -> None:
+                 hover_throttle: float | None, supervisor: SupervisorParams,
+                 climb_stick: ClimbStickMap | None = None) -> None:
+        """`climb_stick`: the vehicle's ALT_HOLD stick map, for the climb-rate hold (None:
+        the firmware's defaults for the curve's dialect)."""
         self.config = config
         self.params = supervisor
         self.estimator: AltEstimator = make_estimator(config.estimator_kind.value,
@@ -38,8 +43,14 @@ class FlightCore:
         self.alt_ctrl = AltitudeController(config.altitude, curve, hover_throttle)
         self.pos_ctrl = PositionController(config.position)
         est = config.estimator
+        climb = None
+        if config.hold_mode is HoldMode.CLIMB_RATE:
+            dialect = Dialect.COPTER4 if curve.kind is CurveKind.COPTER4 else Dialect.APM25
+            climb = ClimbRateHold(config.climb,
+                                  climb_stick or ClimbStickMap.for_dialect(dialect))
         self.supervisor = Supervisor(supervisor, self.alt_ctrl, self.pos_ctrl,
-                                     rest_alt_m=est.rest_alt_m, ground_alt_m=est.ground_alt_m)
+                                     rest_alt_m=est.rest_alt_m, ground_alt_m=est.ground_alt_m,
+                                     climb=climb)
         self.link_down = LinkDownClock()
         self.last: TickOutputs | None = None
         # the newest attitude and pose of any tick: the supervisor flies on them until others come

@@ -28,7 +28,8 @@ from firmware_link import (
 from firmware_link.records import Battery, Dialect, GpsFix, MocapPose
 from firmware_link.truth_link import TruthLink, TruthRecorder
 from gcs.clock import Clock, MonotonicClock, ScaledClock
-from gcs.config import StationConfig, load_config
+from gcs.config import HoldMode, StationConfig, load_config
+from gcs.control.climb_stick import CLIMB_PARAMS, ClimbStickMap
 from gcs.control.position_controller import STICK_PARAMS, with_vehicle_sticks
 from gcs.control.throttle_curve import ThrottleCurve
 from gcs.errors import UsageError
@@ -287,12 +288,17 @@ class StationSession:
         # The throttle curve is how the station turns a thrust into a stick: a default in place
         # of the vehicle's own value would fly a wrong curve, so a failed read stops here.
         names = CURVE_PARAMS.get(link.dialect, ())
+        climbing = config.hold_mode is HoldMode.CLIMB_RATE
+        if climbing:  # and the climb-rate hold's stick is ALT_HOLD's, with its parameters
+            names = (*names, *CLIMB_PARAMS.get(link.dialect, ()))
         try:
             params = link.read_params(names)
         except ParamError as exc:
-            raise ParamError(f"{exc} (the throttle curve needs {', '.join(exc.names)})",
+            raise ParamError(f"{exc} (the throttle curve and the hold's stick need "
+                             f"{', '.join(exc.names)})",
                              exc.names) from None
         curve = ThrottleCurve.for_dialect(link.dialect, params)
+        climb_stick = ClimbStickMap.for_dialect(link.dialect, params) if climbing else None
         if mocap_url is not None:
             config = self._vehicle_sticks(link, config)
         mocap = None
@@ -301,7 +307,7 @@ class StationSession:
             stack.callback(mocap_link.close)
             mocap = MocapFor(mocap_link, sysid)
         station = Station(link, config=config, curve=curve, mocap=mocap, recorder=sink,
-                          clock=self.clock)
+                          clock=self.clock, climb_stick=climb_stick)
         guardian = Guardian.start(link, GuardianSetup(
             link.spec, link.firmware, link.target_system, link.target_component, key,
             config.period_s, clock_speedup(self.clock)))

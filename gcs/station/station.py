@@ -35,6 +35,7 @@ from firmware_link.records import (
 from gcs import params_json, topics
 from gcs.clock import Clock, MonotonicClock
 from gcs.config import StationConfig
+from gcs.control.climb_stick import ClimbStickMap
 from gcs.control.throttle_curve import ThrottleCurve
 from gcs.core.flight_core import FlightCore
 from gcs.core.inputs import NEVER_S, TickInputs
@@ -96,6 +97,7 @@ class Station(StationIntents):
         recorder: Recorder | None = None,
         clock: Clock | None = None,
         supervisor: SupervisorParams | None = None,
+        climb_stick: ClimbStickMap | None = None,
     ) -> None:
         self.config = config or StationConfig()
         self.link = link
@@ -104,7 +106,8 @@ class Station(StationIntents):
         self.clock = clock or MonotonicClock()
         self.curve = curve or ThrottleCurve()
         self.supervisor_params = supervisor or SupervisorParams.for_dialect(link.dialect)
-        self.core = FlightCore(self.config, self.curve, hover_throttle, self.supervisor_params)
+        self.core = FlightCore(self.config, self.curve, hover_throttle, self.supervisor_params,
+                               climb_stick)
         self.loop = FixedRateLoop(self.clock, self.config.period_s, self._tick,
                                   realtime_priority=self.config.realtime_priority)
         self._intents: queue.SimpleQueue[Intent] = queue.SimpleQueue()

@@ -11,8 +11,10 @@ import math
 
 from firmware_link.records import FlightMode, RcCommand
 from gcs.control.altitude_controller import AltControlOutput, AltitudeController
+from gcs.control.climb_rate_hold import ClimbRateHold, ClimbRateOutput
 from gcs.control.position_controller import PositionCommand, PositionController, PositionSetpoint
 from gcs.estimation import SonarStatus
+from gcs.supervisor.climb_mode import ClimbModeCommands, pc_mode
 from gcs.supervisor.envelope import blind_sink_limit
 from gcs.supervisor.outcomes import Outcome, OutcomeKind
 from gcs.supervisor.params import SupervisorParams
@@ -38,13 +40,20 @@ MANUAL_THROTTLE_MODES = frozenset({FlightMode.STABILIZE, FlightMode.ACRO})
 LEVEL = RcCommand(STICK_MID_US, STICK_MID_US, STICK_MIN_US, STICK_MID_US)
 
 
-class StateCommands:
+class StateCommands(ClimbModeCommands):
     """The state the supervisor keeps and the commands its states send."""
 
     def __init__(self, params: SupervisorParams, alt_ctrl: AltitudeController,
-                 pos_ctrl: PositionController, *, rest_alt_m: float, ground_alt_m: float) -> None:
+                 pos_ctrl: PositionController, *, rest_alt_m: float, ground_alt_m: float,
+                 climb: ClimbRateHold | None = None) -> None:
         self.p = params
         self.alt_ctrl = alt_ctrl
+        # the climb-rate hold, flown in ALT_HOLD (climb_mode); None: the direct-throttle hold
+        self.climb = climb
+        self.climb_out: ClimbRateOutput | None = None
+        self.pc_mode = pc_mode(climb)
+        self._alt_mode_seen = False  # climb-rate: ALT_HOLD shown since PC control began
+        self._vehicle_mode = -1  # the last heartbeat's mode
         self.pos_ctrl = pos_ctrl
         self.rest_alt_m = rest_alt_m
         self.ground_alt_m = ground_alt_m
@@ -134,6 +143,8 @@ class StateCommands:
 
     def _end_pc_control(self) -> None:
         self.alt = None
+        self.climb_out = None
+        self._alt_mode_seen = False
         self.position = None
         self.alt_setpoint_m = None
         self._takeoff_wanted = False
@@ -154,7 +165,8 @@ class StateCommands:
         if st is S.KILLED:
             disarm = Action(ActionKind.FORCE_DISARM if self.p.force_disarm else ActionKind.DISARM)
             acts = [disarm]
-            if (self.p.stabilize_to_disarm and inp.vehicle.mode not in MANUAL_THROTTLE_MODES):
+            if ((self.p.stabilize_to_disarm or self.climb is not None)
+                    and inp.vehicle.mode not in MANUAL_THROTTLE_MODES):
                 acts.insert(0, Action(ActionKind.SET_MODE, FlightMode.STABILIZE))
             self._send_every(self.p.disarm_resend_s, *acts)
             return LEVEL, True
@@ -202,9 +214,14 @@ class StateCommands:
             if self._t - self.since_s > self.p.quit_timeout_s:
                 self._note(Level.ERROR, "quit: LAND not confirmed in time")
             self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
-            return (self._hold(inp) if self.alt is not None else self._manual()), True
+            holding = self.alt is not None or self.climb_out is not None
+            return (self._hold(inp) if holding else self._manual()), True
         if st is S.MANUAL:
             return self._manual(), True
+        if st is S.SPOOL_UP and self.climb is not None:
+            return self._climb_spool(inp), True
+        if st is S.TAKEOFF and self.climb is not None:
+            return self._climb_takeoff(inp), True
         if st is S.SPOOL_UP:
             if self._t - self._armed_at_s >= self.p.spool_s:
                 self._go(S.TAKEOFF, "motors spooled: throttle ramp until the vehicle lifts")
@@ -238,6 +255,8 @@ class StateCommands:
         pilot's own stick in MANUAL."""
         if self.on_floor(alt_m):
             return STICK_MIN_US
+        if self.climb is not None and self._vehicle_mode == FlightMode.ALT_HOLD:
+            return STICK_MID_US  # ALT_HOLD's dead zone: the firmware holds its height
         hover = self.alt_ctrl.flown_hover_stick_us()
         if self.state is S.MANUAL:
             return min(hover, self.sticks.throttle_us if self.gate_us is None else self.gate_us)
@@ -292,6 +311,8 @@ class StateCommands:
 
     def _engage(self, inp: TickIn, throttle_us: float, reason: str) -> None:
         self.alt_ctrl.engage(inp.estimate, throttle_us, inp.roll_rad, inp.pitch_rad)
+        if self.climb is not None:
+            self.climb.engage(0.0)
         self.alt_setpoint_m = inp.estimate.alt_m
         self._frozen = None
         self._go(S.HOLD, reason)
@@ -320,6 +341,15 @@ class StateCommands:
         # the controller's profile makes the move: a ramp stopping dead would overshoot
         if self.alt_target_m is not None:
             self.alt_setpoint_m = self.alt_target_m
+        if self.climb is not None:
+            if inp.vehicle.mode == FlightMode.ALT_HOLD:
+                self._alt_mode_seen = True
+            if self._alt_mode_seen:
+                return self._with_position(inp, self._climb_hold(inp))
+            # engaged in the air from STABILIZE: ALT_HOLD asked, the direct hold flies until
+            # a heartbeat shows it (a mid-stick in STABILIZE would be no hover)
+            self.requested_mode, self._asked_why = FlightMode.ALT_HOLD, "for the climb-rate hold"
+            self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.ALT_HOLD))
         floor = self.on_floor(est.alt_m) and self.alt_setpoint_m <= est.alt_m
         sink = blind_sink_limit(est.alt_m - self.rest_alt_m, est.vel_mps,
                                 est.alt_m - self.alt_setpoint_m, self._blind)
@@ -334,6 +364,11 @@ class StateCommands:
                            "lost: LAND")
             self.requested_mode, self._asked_why = FlightMode.LAND, "asked: no rise at full climb"
             self._send_every(self.p.mode_resend_s, Action(ActionKind.SET_MODE, FlightMode.LAND))
+        return self._with_position(inp, RcCommand(STICK_MID_US, STICK_MID_US,
+                                                  self.alt.throttle_us, STICK_MID_US))
+
+    def _with_position(self, inp: TickIn, hold: RcCommand) -> RcCommand:
+        """The hold's throttle with the pilot's sticks, or the mocap position hold's."""
         roll, pitch, yaw = self.sticks.roll_us, self.sticks.pitch_us, self.sticks.yaw_us
         self.position = None
         if self.pos_setpoint is not None:
@@ -350,4 +385,4 @@ class StateCommands:
                 self._note(Level.INFO if fresh else Level.WARNING,
                            "motion capture " + ("tracking" if fresh else "lost: holding level"))
                 self._mocap_ok = fresh
-        return RcCommand(roll, pitch, self.alt.throttle_us, yaw)
+        return RcCommand(roll, pitch, hold.throttle_us, yaw)

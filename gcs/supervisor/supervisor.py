@@ -51,6 +51,8 @@ class Supervisor(StateCommands):
         self._outcomes = []
         for intent in inp.intents:
             self._apply(intent, inp)
+        if inp.vehicle.seen:
+            self._vehicle_mode = inp.vehicle.mode
         self._link = self.p.link_health(inp.vehicle.frame_age_s)
         self._watch_link(inp)
         if self._link is not LinkHealth.LOST:
@@ -65,7 +67,8 @@ class Supervisor(StateCommands):
             transitions=tuple(self._transitions), outcomes=tuple(self._outcomes),
             alt_setpoint_m=self.alt_setpoint_m if self.state in PC_CONTROL else None,
             throttle_gate_us=self.gate_us if self.state is S.MANUAL else None,
-            command_acc_mps2=None if command is None or self.state is not S.HOLD else
+            command_acc_mps2=None if command is None or self.state is not S.HOLD
+            or self.climb_out is not None else
             self.alt_ctrl.accel_for_throttle(command.throttle_us, inp.roll_rad, inp.pitch_rad))
 
     # ------------------------------------------------------------------ intents
@@ -151,9 +154,10 @@ class Supervisor(StateCommands):
             self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING,
                         "altitude hold refused: the vehicle is disarmed")
             return
-        if inp.vehicle.mode != FlightMode.STABILIZE:
+        if inp.vehicle.mode not in (FlightMode.STABILIZE, self.pc_mode):
             self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING, "altitude hold refused: the "
-                        f"PC flies in STABILIZE, the vehicle is in {mode_name(inp.vehicle.mode)}")
+                        f"PC flies in {mode_name(self.pc_mode)} (from STABILIZE), the vehicle is "
+                        f"in {mode_name(inp.vehicle.mode)}")
             return
         self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
         if self.state is S.MANUAL:
@@ -239,7 +243,12 @@ class Supervisor(StateCommands):
         how = self._asked_why if asked else "by itself"
         st = self.state
         if st in PC_CONTROL:
-            if mode != FlightMode.STABILIZE:
+            if self.climb is not None and mode == FlightMode.ALT_HOLD:
+                self._alt_mode_seen = True
+            # climb-rate: STABILIZE until ALT_HOLD shows (the station asked for it)
+            flies = mode == self.pc_mode or (mode == FlightMode.STABILIZE
+                                             and not self._alt_mode_seen)
+            if not flies:
                 self._end_pc_control()
                 self._go(S.VEHICLE, f"vehicle in {mode_name(mode)} {how}: PC control off",
                          Level.INFO if asked else Level.WARNING)

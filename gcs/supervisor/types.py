@@ -43,7 +43,8 @@ AIRBORNE_CAPABLE = frozenset({
 """States in which the vehicle may be armed and flying: a lost link lands it."""
 
 PC_CONTROL = frozenset({SupervisorState.SPOOL_UP, SupervisorState.TAKEOFF, SupervisorState.HOLD})
-"""States in which the station's own controller makes the throttle (needs STABILIZE)."""
+"""States in which the station's own controller makes the throttle (in STABILIZE, or in ALT_HOLD
+for the climb-rate hold: `gcs.supervisor.climb_mode`)."""
 
 
 class LinkHealth(enum.Enum):
