@@ -19,6 +19,7 @@ import math
 import signal
 import socket
 import sys
+from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
 from firmware_link import LinkError, parse_connection_string
@@ -63,6 +64,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     p.add_argument("--lockstep", action="store_true",
                    help="fly the bundled SITL in this process on simulated time, as fast as the "
                         "CPU allows and the same flight for the same --seed (no --connect)")
+    p.add_argument("--faults", type=Path, metavar="FILE",
+                   help="with --lockstep: inject this fault schedule (TOML, see "
+                        "docs/fault-search.md); the same --seed and file replay the flight")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--live", action="store_true", help="print telemetry lines while flying")
     p.set_defaults(func=run)
@@ -213,10 +217,16 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError("--speedup applies to a simulator on this machine only (loopback or a "
                          "pseudo-terminal); a vehicle at --connect flies in real time")
     options = session_options(args, "fly")
+    faults = getattr(args, "faults", None)
+    if faults is not None and not getattr(args, "lockstep", False):
+        raise UsageError("--faults: a fault schedule is flown on the bundled SITL in lockstep; "
+                         "add --lockstep")
     if getattr(args, "lockstep", False):
         from gcs.lockstep_session import LockstepSession
 
-        session: StationSession = LockstepSession(options)
+        session: StationSession = LockstepSession(
+            options, faults=None if faults is None else {"schedule": faults,
+                                                         "schedule_flight": plan})
     else:
         session = StationSession(options)
     with session:
