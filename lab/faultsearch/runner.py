@@ -111,4 +111,5 @@ def result_row(r: RunResult) -> dict[str, Any]:
                            "sim_s": r.sim_s, "wall_s": r.wall_s}
     for m in r.margins:
         row[f"margin.{m.name}"] = m.margin
+        row[f"note.{m.name}"] = m.note
     return row

@@ -77,9 +77,13 @@ def search(flight: SearchFlight, space: Space, opts: SearchOptions,
            execute: Executor = in_process,
            on_row: Callable[[dict[str, Any]], None] | None = None) -> SearchResult:
     """Run the search; stop early at the first violation of `opts.until` if given."""
+    import warnings
+
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
+    # `group` (a schedule's slots are conditional on their kind) is marked experimental
+    warnings.filterwarnings("ignore", category=optuna.exceptions.ExperimentalWarning)
     sampler = (optuna.samplers.RandomSampler(seed=opts.sample_seed) if opts.sampler == "random"
                else optuna.samplers.TPESampler(seed=opts.sample_seed,
                                                n_startup_trials=opts.startup,
