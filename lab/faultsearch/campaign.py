@@ -65,6 +65,18 @@ def ray_executor(ray: Any) -> Executor:
     return execute
 
 
+def _pool_run(args: tuple[SearchFlight, Space, int, dict[str, Any]]) -> dict[str, Any]:
+    return run_params(*args)
+
+
+def pool_executor(pool: Any) -> Executor:
+    """Fly each batch on a `multiprocessing` pool (its processes reused from run to run)."""
+    def execute(flight: SearchFlight, space: Space,
+                batch: Sequence[tuple[int, dict[str, Any]]]) -> list[dict[str, Any]]:
+        return list(pool.map(_pool_run, [(flight, space, n, p) for n, p in batch]))
+    return execute
+
+
 def command(flight: SearchFlight, seed: int, schedule: Path, world: str | None = None) -> str:
     """The one line that replays a run: `quadgcs fly --lockstep` with the search's flight."""
     p = flight.plan
@@ -182,14 +194,19 @@ def summary_table(rows: list[dict[str, Any]], found: list[Violation]) -> str:
 
 
 def run_fault_campaign(c: FaultCampaign, out_dir: Path, ray: Any | None = None,
-                       workers: int = 1, quiet: bool = False) -> tuple[list[dict[str, Any]],
-                                                                      list[Violation]]:
-    """The whole campaign; its rows and violations (files in `out_dir`)."""
+                       workers: int = 1, quiet: bool = False,
+                       execute: Executor | None = None) -> tuple[list[dict[str, Any]],
+                                                                 list[Violation]]:
+    """The whole campaign; its rows and violations (files in `out_dir`). Runs on Ray when
+    given, else on `execute` (default: in this process)."""
     span = flight_span(c.flight, c.space.seeds[0])
     space = replace(c.space, span_s=span)
     opts = SearchOptions(runs=c.runs, random_runs=c.random_runs, sample_seed=c.sample_seed,
                          batch=max(1, workers))
-    execute = ray_executor(ray) if ray is not None else in_process
+    if ray is not None:
+        execute = ray_executor(ray)
+    elif execute is None:
+        execute = in_process
     rows: list[dict[str, Any]] = []
 
     def keep(row: dict[str, Any]) -> None:

@@ -11,6 +11,7 @@ wall clock or draws a random number the seed does not decide, so `seed + schedul
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import replace
 from typing import Any
@@ -42,12 +43,19 @@ PLATEAU_S = 1.0  # a setpoint unchanged this long is a plateau (a step or a desc
 MOVE_M = 0.02
 
 
-class FaultPlan:
-    """One run's faults, on one lockstep SITL and its stations."""
+class RunCapped(BaseException):
+    """A run reached its simulated-time cap (a station that waits for ever on a vehicle that
+    never disarms, say). Not an Exception: nothing on the way may take it for the flight's."""
 
-    def __init__(self, schedule: Schedule, seed: int = 0) -> None:
+
+class FaultPlan:
+    """One run's faults, on one lockstep SITL and its stations; `stop_at_s`: the run's cap in
+    simulated seconds (RunCapped out of the SITL's tick past it)."""
+
+    def __init__(self, schedule: Schedule, seed: int = 0, stop_at_s: float = math.inf) -> None:
         self.schedule = schedule
         self.seed = seed
+        self.stop_at_s = stop_at_s
         self.trace = Trace()
         self.anchors = self.trace.anchors
         self._link = schedule.of(LINK_KINDS)
@@ -101,6 +109,8 @@ class FaultPlan:
 
     def _on_tick(self, t_s: float) -> None:
         assert self.sitl is not None
+        if t_s > self.stop_at_s:
+            raise RunCapped(f"the run reached its cap of {self.stop_at_s:g} simulated s")
         rt = self.sitl.sim.vehicles[0]
         for f in list(self._modes):
             b = f.begins_s(self.anchors)
@@ -239,7 +249,8 @@ class SensorFaults:
         if sample is None:
             return None
         if self._on("sonar_dropout", t_s) is not None:
-            return None
+            # the echo never came back: the HC-SR04 reads 0, as over carpet
+            return replace(sample, distance_m=0.0, valid=False)
         if self._on("sonar_stuck", t_s) is not None and self._last_sonar is not None:
             return replace(self._last_sonar, t_s=sample.t_s)
         self._last_sonar = sample

@@ -14,9 +14,9 @@ from typing import Any
 from gcs.errors import FlightFailed, QuadgcsError
 from gcs.flight_plan import FlightPlan
 from gcs.station.session import SessionOptions
-from lab.faultsearch.inject import FaultPlan, install
+from lab.faultsearch.inject import FaultPlan, RunCapped, install
 from lab.faultsearch.properties import PROPERTIES, Margin, evaluate
-from lab.faultsearch.schedule import Schedule
+from lab.faultsearch.schedule import Schedule, flight_span_s
 from lab.faultsearch.trace import Trace
 
 AFTER_S = 2.0  # the SITL runs on alone at least this long after `fly` returned
@@ -74,27 +74,32 @@ def fly_schedule(flight: SearchFlight, seed: int, schedule: Schedule) -> RunResu
 
     install()
     w0 = time.perf_counter()
-    plan = FaultPlan(schedule, seed)
+    cap_s = flight_span_s(flight.plan)
+    plan = FaultPlan(schedule, seed, cap_s)
     trace = plan.trace
     options = SessionOptions(command="fly", profile=flight.profile, world=flight.world,
                              seed=seed, record=False, fix_failsafe=flight.fix_failsafe,
                              )
     session = LockstepSession(options, faults={"schedule": plan})
     sitl = session.sitl.sitl
-    with session:
-        try:
-            fly_session(session, flight.plan, pilot_signals=False)
-            trace.exit_ok = True
-        except FlightFailed as exc:
-            trace.exit_reason = str(exc)
-        except QuadgcsError as exc:
-            trace.exit_reason = f"{type(exc).__name__}: {exc}"
-        trace.flight_end_s = sitl.t_s
-    # leaving the session landed what flew; the vehicle then has only its own firmware
-    end = sitl.t_s + AFTER_MAX_S
-    until = sitl.t_s + AFTER_S
-    while sitl.t_s < end and (sitl.t_s < until or not _settled(trace)):
-        sitl.advance_to(sitl.t_s + 0.5)
+    try:
+        with session:
+            try:
+                fly_session(session, flight.plan, pilot_signals=False)
+                trace.exit_ok = True
+            except FlightFailed as exc:
+                trace.exit_reason = str(exc)
+            except QuadgcsError as exc:
+                trace.exit_reason = f"{type(exc).__name__}: {exc}"
+            trace.flight_end_s = sitl.t_s
+        # leaving the session landed what flew; the vehicle then has only its own firmware
+        end = min(sitl.t_s + AFTER_MAX_S, cap_s)
+        until = sitl.t_s + AFTER_S
+        while sitl.t_s < end and (sitl.t_s < until or not _settled(trace)):
+            sitl.advance_to(min(sitl.t_s + 0.5, end))
+    except RunCapped as exc:  # the run's verdict is in its trace (never disarmed, say)
+        trace.exit_reason = trace.exit_reason or str(exc)
+        trace.flight_end_s = trace.flight_end_s or plan.stop_at_s
     begun = [(b, f.length_s, f.kind) for f in schedule.faults
              if (b := f.begins_s(trace.anchors)) is not None and b <= sitl.t_s]
     margins = evaluate(trace, begun, flight.properties)

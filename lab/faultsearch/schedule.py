@@ -54,7 +54,7 @@ KINDS: dict[str, Kind] = {
     # a flipped bit fails the frame's checksum: its reader drops it (as the fault proxy's)
     "bitflip": Kind("frames with a flipped bit both ways", "probability", 0.01, 0.5),
     "stall": Kind("the whole SITL stopped, then its missed ticks at once"),
-    "sonar_dropout": Kind("no sonar readings"),
+    "sonar_dropout": Kind("the sonar's echoes lost: it reads 0 (as over carpet)"),
     "sonar_stuck": Kind("the sonar repeats its last reading"),
     "sonar_late": Kind("sonar readings arrive late", "delay s", 0.05, 1.2),
     "imu_spike": Kind("accelerometer z offset", "m/s²", -20.0, 20.0),
