@@ -58,6 +58,7 @@ def test_a_small_search_keeps_every_run_and_replays_its_violations(tmp_path: Pat
                  'max_length_s = 4.0\n')
     c = load_fault_campaign(path)
     rows, found = run_fault_campaign(c, tmp_path / "out", quiet=True)
+    assert len(rows) == 3
     table = pq.read_table(tmp_path / "out" / RESULTS).to_pylist()
     assert [r["run"] for r in table] == [1.0, 2.0, 3.0]
     for r in table:
