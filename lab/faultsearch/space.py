@@ -73,13 +73,15 @@ def _r(x: float) -> float:
 
 def shrink(schedule: Schedule, violates: Callable[[Schedule], bool],
            budget: int = 12) -> tuple[Schedule, int]:
-    """The fewest, shortest faults that still violate (greedy): drop each fault, then halve each
+    """The fewest, shortest faults that still violate (greedy): drop each fault (all of them,
+    when the seed violates without any), then halve each
     length while it still violates. `violates` flies a candidate; at most `budget` flights.
     The smallest schedule found and the flights it took."""
     best = schedule
     tried = 0
     i = 0
-    while i < len(best.faults) and tried < budget and len(best.faults) > 1:
+    # down to no fault at all: a seed that violates on its own is a finding of its own
+    while i < len(best.faults) and tried < budget:
         cand = Schedule(best.faults[:i] + best.faults[i + 1:])
         tried += 1
         if violates(cand):
