@@ -85,6 +85,10 @@ class LockstepSession(StationSession):
         for sysid in self.options.sysids:
             self.vehicles[sysid] = self._open_vehicle(sysid, self.sitl.url(sysid),
                                                       self.sitl.mocaps.get(sysid), None, config)
+        watch = getattr(self.sitl, "watch_station", None)
+        if watch is not None:  # a fault search's pilot and phases (lab.faultsearch)
+            for sysid, v in self.vehicles.items():
+                watch(sysid, v.station)
         # registered after every station's stop, so it runs first: a team lands together
         self._stack.callback(self._land_together)
         if self.sitl.truth is not None:

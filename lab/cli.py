@@ -9,7 +9,7 @@ import sys
 from collections.abc import Sequence
 
 from gcs import cli
-from lab.lockstep import install
+from lab.faultsearch.inject import install
 
 LAB_COMMANDS: tuple[str, ...] = ("lab.commands.campaign",)
 

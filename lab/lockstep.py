@@ -8,15 +8,37 @@ calls it once before its first flight.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from firmware_link import memory
 from gcs.errors import UsageError
 from gcs.lockstep import LockstepClock, LockstepOptions, use_simulator
+from gcs.station.station import Station
 from sitl import lockstep as sitl_lockstep
 
 _instances = itertools.count(1)
+
+
+class FaultSchedule(Protocol):
+    """A flight's fault schedule, put on the SITL and watching its stations
+    (`lab.faultsearch.inject.FaultPlan`)."""
+
+    def attach(self, sitl: sitl_lockstep.LockstepSitl) -> sitl_lockstep.PortFaults: ...
+
+    def watch_station(self, sysid: int, station: Station) -> None: ...
+
+
+ScheduleOpener = Callable[[Any, int, Any], FaultSchedule]
+"""(what a flight's options carry as its schedule, the seed, its FlightPlan) -> the schedule"""
+_schedule_openers: list[ScheduleOpener] = []
+
+
+def use_schedules(opener: ScheduleOpener) -> None:
+    """Let lockstep flights fly fault schedules (`lab.faultsearch` calls this)."""
+    if opener not in _schedule_openers:
+        _schedule_openers.append(opener)
 
 
 def install() -> None:
@@ -49,7 +71,20 @@ class BundledLockstep:
             stall = given.pop("stall", None)
             if stall is not None:
                 self.sitl.stall = sitl_lockstep.Stall(*stall)
-            faults = sitl_lockstep.LinkFaults(**{"seed": options.seed, **given}) if given else None
+            schedule = given.pop("schedule", None)
+            flight = given.pop("schedule_flight", None)  # the FlightPlan it must fit in
+            faults: sitl_lockstep.PortFaults | None = (
+                sitl_lockstep.LinkFaults(**{"seed": options.seed, **given}) if given else None)
+            self.plan: FaultSchedule | None = None
+            if schedule is not None:  # a fault search's schedule (or `fly --faults FILE`)
+                if given:
+                    raise ValueError("a fault schedule carries its own link faults; expected "
+                                     "no other link faults beside it")
+                if not _schedule_openers:
+                    raise ValueError("fault schedules: this program cannot fly them (run it "
+                                     "as quadgcs)")
+                self.plan = _schedule_openers[-1](schedule, options.seed, flight)
+                faults = self.plan.attach(self.sitl)
         except (ValueError, OSError, TypeError) as exc:
             where = f"--world {options.world}: " if isinstance(options.world, Path) else ""
             raise UsageError(f"{where}{exc}") from None
@@ -70,6 +105,12 @@ class BundledLockstep:
         name = f"{self._prefix}/{what}"
         self._names.append(name)
         return memory.plug(name, port)
+
+    def watch_station(self, sysid: int, station: Station) -> None:
+        """The session built `station` for vehicle `sysid`: a fault schedule's pilot acts
+        through it and times its phases on it."""
+        if self.plan is not None:
+            self.plan.watch_station(sysid, station)
 
     def url(self, sysid: int = 1) -> str:
         """The vehicle's connection string."""

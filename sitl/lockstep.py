@@ -20,7 +20,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -77,6 +77,10 @@ class LinkFaults:
         return (self.loss > 0.0
                 and self.loss_start_s <= t_s < self.loss_start_s + self.loss_s)
 
+    def loss_at(self, way: str, t_s: float) -> float:
+        """The probability that a frame going `way` ("down" or "up") is lost at `t_s`."""
+        return self.loss if self.lossy(t_s) else 0.0
+
     def faded(self, way: str, t_s: float) -> bool:
         """Whether way "down" or "up" is in its fade at `t_s`."""
         return (self.fade in (way, "both")
@@ -120,10 +124,29 @@ class Stall:
         return t_s if begin is None else begin
 
 
+class Stopping(Protocol):
+    """What the clock asks of a stalled SITL (`Stall`, or a fault search's stalls)."""
+
+    def resumes_s(self, t_s: float) -> float: ...
+
+    def reached_s(self, t_s: float) -> float: ...
+
+
+class PortFaults(Protocol):
+    """What a faulty port asks of its faults (`LinkFaults`, or a fault search's schedule)."""
+
+    @property
+    def seed(self) -> int: ...
+
+    def faded(self, way: str, t_s: float) -> bool: ...
+
+    def loss_at(self, way: str, t_s: float) -> float: ...
+
+
 class _Lossy:
     """One way of a faulty port: whole frames through or lost, as the faults say."""
 
-    def __init__(self, faults: LinkFaults, way: str, rng: np.random.Generator) -> None:
+    def __init__(self, faults: PortFaults, way: str, rng: np.random.Generator) -> None:
         self.faults = faults
         self.way = way
         self._rng = rng
@@ -136,11 +159,12 @@ class _Lossy:
         if f.faded(self.way, t_s):
             self.lost_frames += sum(ok for ok, _ in self._split.feed(data))
             return b""
-        if not f.lossy(t_s):
+        loss = f.loss_at(self.way, t_s)
+        if loss <= 0.0:
             return data
         out = bytearray()
         for ok, chunk in self._split.feed(data):
-            if ok and self._rng.random() < f.loss:
+            if ok and self._rng.random() < loss:
                 self.lost_frames += 1
             else:
                 out += chunk
@@ -153,7 +177,7 @@ class MemoryPort:
 
     def __init__(self, owner: LockstepSitl, name: str,
                  receive: Callable[[bytes], None] | None,
-                 faults: LinkFaults | None = None) -> None:
+                 faults: PortFaults | None = None) -> None:
         self.owner = owner
         self.name = name
         self._receive = receive
@@ -240,7 +264,10 @@ class LockstepSitl:
         self._mocap = MocapEncoder(mavlink1)
         self._truth = TruthEncoder(mavlink1)
         self.ticks = 0
-        self.stall: Stall | None = None
+        # a stalled SITL (`Stall`, or any object with its `resumes_s` and `reached_s`)
+        self.stall: Stopping | None = None
+        # called with the simulated time after every tick (a fault search's timed faults)
+        self.tick_hooks: list[Callable[[float], None]] = []
 
     @property
     def t_s(self) -> float:
@@ -253,7 +280,7 @@ class LockstepSitl:
         return bool(self.sim.world.mocap_enabled)
 
     # ------------------------------------------------------------------ ports
-    def vehicle_port(self, sysid: int = 1, faults: LinkFaults | None = None) -> MemoryPort:
+    def vehicle_port(self, sysid: int = 1, faults: PortFaults | None = None) -> MemoryPort:
         """A new link to vehicle `sysid` (SR0_* stream rates, like the TCP endpoint), with
         `faults` on it if given."""
         rt = self.sim.vehicle(sysid)
@@ -307,6 +334,8 @@ class LockstepSitl:
         sim = self.sim
         sim.tick()
         self.ticks += 1
+        for hook in self.tick_hooks:
+            hook(sim.t_s)
         # what the tick sent leaves at the tick's time (a fade's window is judged on it)
         self._now_s = max(self._now_s, sim.t_s)
         for ch, port in self._vehicle_ports:

@@ -23,6 +23,7 @@ from sitl.autopilot.rangefinder import firmware_reading
 from sitl.link.channel import Channel
 from sitl.link.handler import VehicleLink
 from sitl.link.view import GeoOrigin, VehicleView
+from sitl.sensor_hook import SensorHook
 from sitl.sensors import MocapSample
 from sitl.tick_record import tick_record
 from sitl.vehicle_model import SimVehicle
@@ -89,6 +90,8 @@ class VehicleRuntime:
         self._next_prox_s = 0.0
         self._next_rad_s = 0.0
         self.mocap_out: list[MocapFrame] = []
+        # faults on the readings (a fault search's, `sitl.sensor_hook`); None in every flight
+        self.sensor_hook: SensorHook | None = None
         self._refresh_cache()
 
     def add_channel(
@@ -102,7 +105,8 @@ class VehicleRuntime:
         v = self.vehicle
         t = v.t_s
         self.view.t_s = t
-        imu = v.imu()
+        hook = self.sensor_hook
+        imu = v.imu() if hook is None else hook.imu(t, v.imu())
         c = self.view.cache
         c.acc_b, c.gyro_b, c.temperature_c = imu.acc_b, imu.gyro_b, imu.temperature_c
         baro_alt = None
@@ -111,7 +115,7 @@ class VehicleRuntime:
             b = v.baro()
             baro_alt = b.alt_m
             c.pressure_pa = b.pressure_pa
-        sonar = v.sonar()
+        sonar = v.sonar() if hook is None else hook.sonar(t, v.sonar())
         sonar_m = None
         if sonar is not None:
             c.sonar_m = sonar.distance_m if sonar.valid else None
@@ -119,7 +123,7 @@ class VehicleRuntime:
             c.rangefinder = reading
             # the autopilot uses only what its driver calls in range (not below RNGFND min)
             sonar_m = reading.distance_cm / 100.0 if reading.valid else None
-        batt = v.battery
+        batt = v.battery if hook is None else hook.battery(t, v.battery)
         c.battery_v, c.current_a = batt.voltage_v, batt.current_a
         c.remaining_pct = batt.remaining_pct
         if t + 1e-9 >= self._next_prox_s:

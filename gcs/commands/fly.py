@@ -19,6 +19,7 @@ import math
 import signal
 import socket
 import sys
+from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
 from firmware_link import FirmwareInfo, LinkError, parse_connection_string
@@ -72,6 +73,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
                    "override flown blind holds the height); throttle: the PC's PID flies the "
                    "throttle in STABILIZE (thesis ch. 7). Default: the --config file's "
                    "hold_mode, else throttle")
+    p.add_argument("--faults", type=Path, metavar="FILE",
+                   help="with --lockstep: inject this fault schedule (TOML, see "
+                        "docs/fault-search.md); the same --seed and file replay the flight")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--live", action="store_true", help="print telemetry lines while flying")
     p.set_defaults(func=run)
@@ -232,10 +236,16 @@ def fly(args: argparse.Namespace) -> dict[str, Any]:
     config = load_config(options.config)
     if getattr(args, "hold_mode", None) is not None:
         config = dataclasses.replace(config, hold_mode=HoldMode(args.hold_mode))
+    faults = getattr(args, "faults", None)
+    if faults is not None and not getattr(args, "lockstep", False):
+        raise UsageError("--faults: a fault schedule is flown on the bundled SITL in lockstep; "
+                         "add --lockstep")
     if getattr(args, "lockstep", False):
         from gcs.lockstep_session import LockstepSession
 
-        session: StationSession = LockstepSession(options, config=config)
+        session: StationSession = LockstepSession(
+            options, config=config,
+            faults=None if faults is None else {"schedule": faults, "schedule_flight": plan})
     else:
         session = StationSession(options, config=config)
     with session:

@@ -54,7 +54,10 @@ def run(args: argparse.Namespace) -> int:
     )
     from lab.campaign.plots import axis_plots
     from lab.campaign.pool import need
+    from lab.faultsearch.spec import is_fault_search
 
+    if is_fault_search(args.file):
+        return _fault_search(args)
     c = load_campaign(args.file)
     need("pyarrow")  # the results file: before any run, not after the first
     if args.workers is not None and args.workers < 1:
@@ -93,3 +96,32 @@ def run(args: argparse.Namespace) -> int:
               f"{outcome.results} (run the same file again to resume)", file=sys.stderr)
         return 130
     return 0
+
+
+def _fault_search(args: argparse.Namespace) -> int:
+    """kind = "fault-search": hunt for unsafe flights (lab.faultsearch)."""
+    from lab.campaign import ray_session
+    from lab.campaign.pool import need
+    from lab.faultsearch.campaign import PLOT, RESULTS, margins_plot, run_fault_campaign
+    from lab.faultsearch.campaign import summary_table as fault_table
+    from lab.faultsearch.spec import load_fault_campaign
+
+    c = load_fault_campaign(args.file)
+    need("pyarrow")
+    need("optuna")
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers}: expected at least 1")
+    out_dir = args.output or DEFAULT_OUTPUT / c.name
+    cpus = args.workers or os.cpu_count() or 1
+    with ray_session(args.address, cpus) as ray:
+        workers = int(ray.cluster_resources().get("CPU", cpus))
+        rows, found = run_fault_campaign(c, out_dir, ray, workers, quiet=args.quiet)
+    print(fault_table(rows, found))
+    print(f"{len(rows)} runs in {out_dir / RESULTS}; {len(found)} properties violated")
+    for v in found:
+        print(f"{v.prop}: run {v.run}, margin {v.margin:.3f} ({v.note}); shrunk schedule "
+              f"{v.schedule}\n  {v.command}")
+    if not args.no_plots:
+        pic = margins_plot(rows, out_dir / PLOT)
+        print(f"plot: {pic}" if pic else "plot: none drawn (matplotlib is not installed)")
+    return 130 if len(rows) < c.runs else 0
