@@ -40,6 +40,10 @@ from sitl.autopilot.spool import Spool
 from sitl.autopilot.state import AutopilotState, SensorSample, SystemStatus
 
 GYRO_CAL_S = 1.0  # boot-time gyro calibration of the attitude estimator
+# The accelerometer range each firmware configures (3.2.1's MPU-6000 driver: ±8 g; 4.x: ±16 g),
+# whatever the ±2 g the station's RAW_IMU is scaled to: a 4 m/s floor impact (≈ 10 g over a
+# 10 ms loop) reaches the estimator, which clipped at 2 g went on believing it fell for seconds.
+ACC_RANGE_G = {Profile.APM25: 8.0, Profile.COPTER4: 16.0}
 LAND_PAUSE_S = 4.0  # LAND_WITH_DELAY_MS of both firmwares
 
 
@@ -94,6 +98,8 @@ class Autopilot(ModeRunner):
         self._cal_sum = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
         self._cal_n = 0
         self._acc_offset = (0.0, 0.0, 0.0)
+        self._acc_lsb = ACC_RANGE_G[profile] * GRAVITY_MSS / 32768.0
+        self._acc_max = 32767.0 * self._acc_lsb
         self.calibrated = False
         self._refresh_gains()
 
@@ -245,12 +251,14 @@ class Autopilot(ModeRunner):
             self.arm_completed = CommandResult(True)
         st = self.state
         g = self.gains
+        raw = (self._acc_counts(s.acc_b[0]), self._acc_counts(s.acc_b[1]),
+               self._acc_counts(s.acc_b[2]))
         if not self.calibrated:
-            self._calibrate(s, t_s)
+            self._calibrate(s.gyro_b, raw, t_s)
         acc_b = (
-            s.acc_b[0] - self._acc_offset[0],
-            s.acc_b[1] - self._acc_offset[1],
-            s.acc_b[2] - self._acc_offset[2],
+            raw[0] - self._acc_offset[0],
+            raw[1] - self._acc_offset[1],
+            raw[2] - self._acc_offset[2],
         )
         self.ahrs.update(s.gyro_b, acc_b, dt_s)
         roll, pitch, yaw = self.ahrs.euler()
@@ -313,10 +321,18 @@ class Autopilot(ModeRunner):
             self._timed_texts = [x for x in self._timed_texts if x[0] > t_s + 1e-9]
             self.texts.extend((sev, text) for _, sev, text in due)
 
-    def _calibrate(self, s: SensorSample, t_s: float) -> None:
+    def _acc_counts(self, a_mss: float) -> float:
+        """The firmware's accelerometer reading: its own range's LSB, saturated."""
+        lsb = self._acc_lsb
+        a = round(a_mss / lsb) * lsb
+        return a if -self._acc_max <= a <= self._acc_max else math.copysign(self._acc_max, a)
+
+    def _calibrate(
+        self, gyro_b: tuple[float, float, float], acc_b: tuple[float, float, float], t_s: float
+    ) -> None:
         for i in range(3):
-            self._cal_sum[i] += s.gyro_b[i]
-            self._cal_sum[3 + i] += s.acc_b[i]
+            self._cal_sum[i] += gyro_b[i]
+            self._cal_sum[3 + i] += acc_b[i]
         self._cal_n += 1
         if t_s + 1e-9 >= GYRO_CAL_S:
             n = float(self._cal_n)
