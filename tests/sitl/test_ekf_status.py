@@ -4,11 +4,12 @@ its GPS, 0xe7 once the rangefinder reads in range, 0x33f / 0x37f with a GPS posi
 from __future__ import annotations
 
 import pytest
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 from sitl.autopilot import AutopilotOptions, Profile
 from sitl.simulation import Simulation
 from sitl.world import default_world
-from tests.sitl.gcs_peer import MemoryGcs, mavlink
+from tests.sitl.gcs_peer import MemoryGcs
 
 POS_HORIZ_REL = 0x8
 POS_HORIZ_ABS = 0x10
