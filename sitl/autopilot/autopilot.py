@@ -177,6 +177,9 @@ class Autopilot(ModeRunner):
             self.alt_ctrl.reset(
                 self.inav.alt_m * 100.0, self._last_throttle, self.inav.climb_ms * 100.0
             )
+        # 3.2.1's surface tracking re-aims when it has not run for a second (SONAR_TIMEOUT_MS):
+        # a mode change stands for that
+        self.surface.target_cm = None
         if mode in (FlightMode.RTL, FlightMode.SMART_RTL):
             self.rtl.start(self.inav.alt_m * 100.0, self._t_s, self._rtl_params,
                            smart=mode is FlightMode.SMART_RTL)
