@@ -18,13 +18,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 from sitl.autopilot import FlightMode, Profile
 from sitl.simulation import Simulation
 from sitl.world import World, default_world
 from tests.fixture_paths import FIXTURES
 from tests.sitl.flight_helpers import HOVER_STICK_US, Pilot, arm
-from tests.sitl.gcs_peer import MemoryGcs, mavlink
+from tests.sitl.gcs_peer import MemoryGcs
 
 STEPS_US = (1500, 1550, 1600, 1700, 1500, 1450, 1400, 1300, 1500, 1900, 1500, 1100, 1500)
 STEP_S = 4.0
