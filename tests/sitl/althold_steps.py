@@ -141,6 +141,7 @@ def tall_world() -> World:
 def fly_steps(
     profile: Profile, seed: int = 1, noise: bool = True, settle_s: float = 6.0,
     steps: tuple[int, ...] = STEPS_US, climb_in_stabilize: bool = False,
+    world: World | None = None,
 ) -> SitlFlight:
     """Arm in STABILIZE, climb to ~1.5 m, ALT_HOLD at 1500 µs, then the fixture's steps.
 
@@ -149,8 +150,8 @@ def fly_steps(
     differ for 3.2.1's surface tracking: engaged in the hover, its sonar target is the reading
     then; after a climb in ALT_HOLD it is wherever the stick's rate left it, between two of the
     analog sonar's 6 cm steps, and the hold dithers across the step (0.4-0.5 cm), as the
-    firmware's own arithmetic does."""
-    sim = Simulation(tall_world(), profile, 1, seed=seed, noise=noise)
+    firmware's own arithmetic does. `world` replaces the tall hall (its sensors, say)."""
+    sim = Simulation(world or tall_world(), profile, 1, seed=seed, noise=noise)
     gcs = MemoryGcs(sim, sim.memory_link(1), mavlink1=profile is Profile.APM25)
     gcs.heartbeat()
     gcs.send(mavlink.MAVLink_request_data_stream_message(1, 1, 0, 10, 1))
