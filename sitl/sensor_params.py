@@ -23,8 +23,9 @@ class ImuParams:
     acc_bias_max_mps2: float = 0.15  # per-run constant bias drawn uniformly in ±this
     acc_vibration_mps2_full: float = 0.8  # vibration RMS at full rotor speed, ∝ mean speed
     # share of that RMS left in the flight controller's own loop-averaged reading (sensors/imu.py):
-    # a 20 Hz low-pass against blade-rate vibration at >= 100 Hz leaves <= 1/5 (one pole)
-    vibration_residue: float = 0.2
+    # the MPU's 20 Hz DLPF (two poles) against rotor vibration at >= 100 Hz leaves <= 1/25;
+    # 1/10 keeps a margin
+    vibration_residue: float = 0.1
     gyro_range_dps: float = 2000.0
     gyro_noise_radps: float = 0.006
     gyro_bias_max_radps: float = 0.01

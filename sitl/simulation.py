@@ -109,7 +109,7 @@ class VehicleRuntime:
         if t + 1e-9 >= self._next_baro_s:
             self._next_baro_s += 1.0 / BARO_RATE_HZ
             b = v.baro()
-            baro_alt = b.alt_m
+            baro_alt = b.alt_fw_m  # the firmware's driver's average; the station gets b.alt_m
             c.pressure_pa = b.pressure_pa
         sonar = v.sonar()
         sonar_m = None

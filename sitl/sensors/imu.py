@@ -11,13 +11,14 @@ so a = counts · g · full_scale_g / 32768; that is what `acc_b` holds.
 whole, as white noise at the output rate. The flight controller does not read the sensor that
 way: its driver takes every sample at the sensor's own rate through the low-pass filter (the
 MPU's DLPF on the APM 2.5, INS_ACCEL_FILTER on 4.x) and averages them over its loop, so rotor
-vibration, at the blade frequency (≥ 100 Hz), leaves only a residue in what its estimator and
-controllers integrate; the white noise of the sensor itself stays whole. Were the vibration
-integrated as white noise, any inertial estimator corrected by a slow baro (3.2.1's third-order
-filter with INAV_TC_Z 5 s, 4.x's EKF) would wander by centimetres, where the firmware on its
-simulators holds to a millimetre. `acc_fw_b` is that reading, from the same random draws (so what
-a station receives is unchanged), and not clipped at the ±2 g the station's samples are scaled
-to: the firmware configures its own range, which `Autopilot` applies.
+vibration, at the rotor frequency (>= 100 Hz), leaves only a residue (`vibration_residue`) in
+what its estimator and controllers integrate; the white noise of the sensor itself stays
+whole. Were the vibration integrated as white noise, any inertial estimator corrected by a
+slow baro (3.2.1's third-order filter with INAV_TC_Z 5 s, 4.x's EKF) would wander by
+centimetres, where the firmware on its simulators holds to a millimetre. `acc_fw_b` is that
+reading, from the same random draws (so what a station receives is unchanged), and not
+clipped at the ±2 g the station's samples are scaled to: the firmware configures its own
+range, which `Autopilot` applies.
 """
 
 from __future__ import annotations
