@@ -130,11 +130,12 @@ class VehicleRuntime:
             c.radiation_cps = v.radiation(1.0 / RADIATION_RATE_HZ)
         sample = SensorSample(
             gyro_b=imu.gyro_b,
-            acc_b=imu.acc_fw_b,  # the firmware's own loop-averaged reading, not the station's
+            acc_b=imu.acc_b,
             baro_alt_m=baro_alt,
             sonar_m=sonar_m,
             sonar_fresh=sonar is not None,
             battery_v=batt.voltage_v,
+            acc_fw_b=imu.acc_fw_b,  # the firmware's own loop-averaged reading
         )
         out = self.autopilot.update(sample, t, dt_s)
         v.step(out.physics_order(), dt_s)

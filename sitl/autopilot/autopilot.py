@@ -254,21 +254,23 @@ class Autopilot(ModeRunner):
             self.arm_completed = CommandResult(True)
         st = self.state
         g = self.gains
-        raw = (self._acc_counts(s.acc_b[0]), self._acc_counts(s.acc_b[1]),
-               self._acc_counts(s.acc_b[2]))
         if not self.calibrated:
-            self._calibrate(s.gyro_b, raw, t_s)
-        acc_b = (
-            raw[0] - self._acc_offset[0],
-            raw[1] - self._acc_offset[1],
-            raw[2] - self._acc_offset[2],
-        )
+            self._calibrate(s.gyro_b, s.acc_b, t_s)
+        off = self._acc_offset
+        acc_b = (s.acc_b[0] - off[0], s.acc_b[1] - off[1], s.acc_b[2] - off[2])
+        # The vertical navigation and the altitude controller integrate the driver's loop
+        # average in the firmware's own range (sensors/imu.py); the attitude estimator keeps
+        # the single sample with its whole vibration, which only makes it noisier than the
+        # firmware's (and leaves every STABILIZE flight as it was).
+        fw = s.acc_fw_b if s.acc_fw_b is not None else s.acc_b
+        acc_v = (self._acc_counts(fw[0]) - off[0], self._acc_counts(fw[1]) - off[1],
+                 self._acc_counts(fw[2]) - off[2])
         self.ahrs.update(s.gyro_b, acc_b, dt_s)
         roll, pitch, yaw = self.ahrs.euler()
         st.roll_rad, st.pitch_rad, st.yaw_rad = roll, pitch, yaw
         st.gyro_rads = self.ahrs.gyro_corrected
         tilt_cos = math.cos(roll) * math.cos(pitch)
-        f_n = self.ahrs.body_to_ned(acc_b)
+        f_n = self.ahrs.body_to_ned(acc_v)
         acc_up = -(f_n[2] + GRAVITY_MSS)
         if s.baro_alt_m is not None:
             self.inav.correct(s.baro_alt_m)
