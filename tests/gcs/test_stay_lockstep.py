@@ -102,6 +102,11 @@ def test_quit_mid_air_stays_until_disarmed_and_nothing_relaunches(vehicle: str) 
         assert max(h for _, h, _, _ in watch.after(t_quit)) <= 1.0 + 0.3
 
 
+@pytest.mark.xfail(strict=True, reason=(
+    "#32: a hold safe to fly blind is not built: on the SITL's 3.2.1 sonar (6 cm steps) the "
+    "direct-throttle hold of seed 3 swings 1420-1680 us, and the last override before the fade "
+    "(~+60 us over hover) carries the vehicle to 18 m in the 5 s before the GCS failsafe's "
+    "LAND, which then needs 36 s at 0.5 m/s (the real 3.2.1: a last 1415 us took it to 6.2 m)"))
 @pytest.mark.parametrize("vehicle", list(VEHICLES))
 def test_link_lost_both_ways_then_back_disarmed_and_stays_on_the_floor(vehicle: str) -> None:
     """15 s both ways, as the fixtures' fades: nothing heard, the station keeps asking LAND
@@ -131,10 +136,6 @@ def test_link_lost_both_ways_then_back_disarmed_and_stays_on_the_floor(vehicle: 
         assert FlightMode.RTL not in {m for *_, m in after} or vehicle.endswith("rtl-alt-0")
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "#32: a hold safe to fly blind is not built: on the SITL's 3.2.1 sonar (6 cm steps) the "
-    "direct-throttle hold of seed 3 swings 0.85-1.22 m, and in the 1.5 s the station flies "
-    "blind before its LAND the vehicle rises to 1.319 m (0.32 m over the hold; bound 0.3)"))
 @pytest.mark.parametrize("vehicle", list(VEHICLES))
 def test_downlink_lost_for_good_the_station_lands_it_and_stays_until_it_disarms(
         vehicle: str) -> None:
