@@ -18,7 +18,8 @@ slow baro (3.2.1's third-order filter with INAV_TC_Z 5 s, 4.x's EKF) would wande
 centimetres, where the firmware on its simulators holds to a millimetre. `acc_fw_b` is that
 reading, from the same random draws (so what a station receives is unchanged), and not
 clipped at the ±2 g the station's samples are scaled to: the firmware configures its own
-range, which `Autopilot` applies.
+range, which `Autopilot` applies (to its vertical navigation and altitude control; its attitude
+estimator keeps `acc_b`, which is only noisier).
 """
 
 from __future__ import annotations
