@@ -22,6 +22,10 @@ class ImuParams:
     acc_noise_mps2: float = 0.06  # white, RMS per axis
     acc_bias_max_mps2: float = 0.15  # per-run constant bias drawn uniformly in ±this
     acc_vibration_mps2_full: float = 0.8  # vibration RMS at full rotor speed, ∝ mean speed
+    # share of that RMS left in the flight controller's own loop-averaged reading (sensors/imu.py):
+    # the MPU's 20 Hz DLPF (two poles) against rotor vibration at >= 100 Hz leaves <= 1/25;
+    # 1/10 keeps a margin
+    vibration_residue: float = 0.1
     gyro_range_dps: float = 2000.0
     gyro_noise_radps: float = 0.006
     gyro_bias_max_radps: float = 0.01
@@ -44,6 +48,7 @@ class ImuParams:
             "gyro_vibration_radps_full",
         ):
             check_range(self, name, 0.0, 100.0)
+        check_range(self, "vibration_residue", 0.0, 1.0)
 
 
 @dataclass(frozen=True, slots=True)

@@ -113,7 +113,7 @@ class VehicleRuntime:
         if t + 1e-9 >= self._next_baro_s:
             self._next_baro_s += 1.0 / BARO_RATE_HZ
             b = v.baro()
-            baro_alt = b.alt_m
+            baro_alt = b.alt_fw_m  # the firmware's driver's average; the station gets b.alt_m
             c.pressure_pa = b.pressure_pa
         sonar = v.sonar() if hook is None else hook.sonar(t, v.sonar())
         sonar_m = None
@@ -139,6 +139,7 @@ class VehicleRuntime:
             sonar_m=sonar_m,
             sonar_fresh=sonar is not None,
             battery_v=batt.voltage_v,
+            acc_fw_b=imu.acc_fw_b,  # the firmware's own loop-averaged reading
         )
         out = self.autopilot.update(sample, t, dt_s)
         v.step(out.physics_order(), dt_s)

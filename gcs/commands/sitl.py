@@ -23,6 +23,8 @@ FORWARDED: tuple[tuple[str, str], ...] = (
     ("mocap_port", "--mocap-port"),
     ("copter4_version", "--copter4-version"),
     ("truth_port", "--truth-port"),
+    ("rc_input", "--rc-input"),
+    ("home_distance", "--home-distance"),
 )
 
 
@@ -56,6 +58,16 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     p.add_argument("--copter4-version", choices=["4.6", "4.7"],
                    help="copter4 parameter names: 4.7 (MAV_GCS_SYSID, MAVn_*) or 4.6 for any "
                         "4.x before 4.7 (SYSID_MYGCS, SRn_*) (default 4.7)")
+    p.add_argument("--rc-input", choices=["absent", "min", "mid"],
+                   help="the vehicles' RC receiver: min = present, throttle at 1000 µs (the real "
+                        "simulators' default), mid = throttle at 1500 µs, absent = none (the "
+                        "radio failsafe acts when the overrides stop) (default min)")
+    p.add_argument("--gps", action=argparse.BooleanOptionalAction, default=None,
+                   help="a GPS fix with home set, as the real simulators have: RTL flies and "
+                        "3.2.1's GCS failsafe climbs to RTL_ALT (default: no fix, as indoors)")
+    p.add_argument("--home-distance", metavar="M",
+                   help="how far from home the GPS puts the vehicle (default 3 m; over 2 m, "
+                        "3.2.1's GCS failsafe picks RTL, else LAND)")
     p.add_argument("--truth-port", metavar="PORT",
                    help="open a ground-truth TCP endpoint for scoring (0 = OS-chosen; default: "
                         "none)")
@@ -78,6 +90,9 @@ def sitl_argv(args: argparse.Namespace) -> list[str]:
         argv.append("--no-noise")
     if getattr(args, "realistic_boot", False):
         argv.append("--realistic-boot")
+    gps = getattr(args, "gps", None)
+    if gps is not None:
+        argv.append("--gps" if gps else "--no-gps")
     return argv
 
 

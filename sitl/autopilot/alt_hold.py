@@ -281,7 +281,9 @@ class SurfaceTracker:
             return target_rate_cms
         assert self.sonar_alt_cm is not None
         if self.target_cm is None:
-            self.target_cm = self.sonar_alt_cm
+            # engaged: the surface distance the altitude target stands for (both firmwares add
+            # the altitude error, so a vehicle still closing on its target does not re-aim)
+            self.target_cm = self.sonar_alt_cm + (alt_target_cm - alt_cm)
         self.target_cm += target_rate_cms * dt_s
         self.target_cm = min(
             self.sonar_alt_cm + LEASH_CM, max(self.sonar_alt_cm - LEASH_CM, self.target_cm)

@@ -40,6 +40,10 @@ from sitl.autopilot.spool import Spool
 from sitl.autopilot.state import AutopilotState, SensorSample, SystemStatus
 
 GYRO_CAL_S = 1.0  # boot-time gyro calibration of the attitude estimator
+# The accelerometer range each firmware configures (3.2.1's MPU-6000 driver: ±8 g; 4.x: ±16 g),
+# whatever the ±2 g the station's RAW_IMU is scaled to: a 4 m/s floor impact (≈ 10 g over a
+# 10 ms loop) reaches the estimator, which clipped at 2 g went on believing it fell for seconds.
+ACC_RANGE_G = {Profile.APM25: 8.0, Profile.COPTER4: 16.0}
 LAND_PAUSE_S = 4.0  # LAND_WITH_DELAY_MS of both firmwares
 
 
@@ -94,6 +98,8 @@ class Autopilot(ModeRunner):
         self._cal_sum = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
         self._cal_n = 0
         self._acc_offset = (0.0, 0.0, 0.0)
+        self._acc_lsb = ACC_RANGE_G[profile] * GRAVITY_MSS / 32768.0
+        self._acc_max = 32767.0 * self._acc_lsb
         self.calibrated = False
         self._refresh_gains()
 
@@ -171,6 +177,9 @@ class Autopilot(ModeRunner):
             self.alt_ctrl.reset(
                 self.inav.alt_m * 100.0, self._last_throttle, self.inav.climb_ms * 100.0
             )
+        # 3.2.1's surface tracking re-aims when it has not run for a second (SONAR_TIMEOUT_MS):
+        # a mode change stands for that
+        self.surface.target_cm = None
         if mode in (FlightMode.RTL, FlightMode.SMART_RTL):
             self.rtl.start(self.inav.alt_m * 100.0, self._t_s, self._rtl_params,
                            smart=mode is FlightMode.SMART_RTL)
@@ -250,18 +259,22 @@ class Autopilot(ModeRunner):
         st = self.state
         g = self.gains
         if not self.calibrated:
-            self._calibrate(s, t_s)
-        acc_b = (
-            s.acc_b[0] - self._acc_offset[0],
-            s.acc_b[1] - self._acc_offset[1],
-            s.acc_b[2] - self._acc_offset[2],
-        )
+            self._calibrate(s.gyro_b, s.acc_b, t_s)
+        off = self._acc_offset
+        acc_b = (s.acc_b[0] - off[0], s.acc_b[1] - off[1], s.acc_b[2] - off[2])
+        # The vertical navigation and the altitude controller integrate the driver's loop
+        # average in the firmware's own range (sensors/imu.py); the attitude estimator keeps
+        # the single sample with its whole vibration, which only makes it noisier than the
+        # firmware's (and leaves every STABILIZE flight as it was).
+        fw = s.acc_fw_b if s.acc_fw_b is not None else s.acc_b
+        acc_v = (self._acc_counts(fw[0]) - off[0], self._acc_counts(fw[1]) - off[1],
+                 self._acc_counts(fw[2]) - off[2])
         self.ahrs.update(s.gyro_b, acc_b, dt_s)
         roll, pitch, yaw = self.ahrs.euler()
         st.roll_rad, st.pitch_rad, st.yaw_rad = roll, pitch, yaw
         st.gyro_rads = self.ahrs.gyro_corrected
         tilt_cos = math.cos(roll) * math.cos(pitch)
-        f_n = self.ahrs.body_to_ned(acc_b)
+        f_n = self.ahrs.body_to_ned(acc_v)
         acc_up = -(f_n[2] + GRAVITY_MSS)
         if s.baro_alt_m is not None:
             self.inav.correct(s.baro_alt_m)
@@ -317,10 +330,18 @@ class Autopilot(ModeRunner):
             self._timed_texts = [x for x in self._timed_texts if x[0] > t_s + 1e-9]
             self.texts.extend((sev, text) for _, sev, text in due)
 
-    def _calibrate(self, s: SensorSample, t_s: float) -> None:
+    def _acc_counts(self, a_mss: float) -> float:
+        """The firmware's accelerometer reading: its own range's LSB, saturated."""
+        lsb = self._acc_lsb
+        a = round(a_mss / lsb) * lsb
+        return a if -self._acc_max <= a <= self._acc_max else math.copysign(self._acc_max, a)
+
+    def _calibrate(
+        self, gyro_b: tuple[float, float, float], acc_b: tuple[float, float, float], t_s: float
+    ) -> None:
         for i in range(3):
-            self._cal_sum[i] += s.gyro_b[i]
-            self._cal_sum[3 + i] += s.acc_b[i]
+            self._cal_sum[i] += gyro_b[i]
+            self._cal_sum[3 + i] += acc_b[i]
         self._cal_n += 1
         if t_s + 1e-9 >= GYRO_CAL_S:
             n = float(self._cal_n)

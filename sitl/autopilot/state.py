@@ -24,11 +24,13 @@ class SensorSample:
     """What the autopilot's sensors delivered this tick (SI, body FRD)."""
 
     gyro_b: tuple[float, float, float]
-    acc_b: tuple[float, float, float]  # specific force, m/s²
+    acc_b: tuple[float, float, float]  # specific force, m/s², one sample (RAW_IMU's)
     baro_alt_m: float | None = None  # new barometric altitude, up positive
     sonar_m: float | None = None  # sonar distance of a new reading, None if it had no echo
     sonar_fresh: bool = False  # a sonar reading (with or without echo) arrived this tick
     battery_v: float = 12.6
+    # the same as the firmware's driver averages it over the loop, unclipped (None: acc_b)
+    acc_fw_b: tuple[float, float, float] | None = None
 
 
 @dataclass

@@ -24,7 +24,14 @@ GPS_NO_FIX = 1
 GPS_FIX_3D = 3
 GPS_SATELLITES = 10  # what the real simulators report with a fix
 GPS_EPH_CM = 121  # HDOP 1.21, the real simulators' value
-EKF_FLAGS_ATTITUDE_VERT = 0x1 | 0x4 | 0x8 | 0x20  # attitude, vertical velocity/position
+# EKF_STATUS_REPORT flags as the real 4.7 reports them (fixtures' althold-steps tlog): without a
+# GPS, attitude, horizontal velocity (held at zero), vertical velocity, absolute vertical
+# position and constant-position mode (0xa7), no horizontal position; with a fix and home, both
+# horizontal positions and their predictions (0x33f); either way 0x40 (height above ground)
+# while the rangefinder reads in range.
+EKF_FLAGS_NO_GPS = 0x1 | 0x2 | 0x4 | 0x20 | 0x80
+EKF_FLAGS_GPS = 0x1 | 0x2 | 0x4 | 0x8 | 0x10 | 0x20 | 0x100 | 0x200
+EKF_FLAG_POS_VERT_AGL = 0x40
 ESC_RPM_AT_FULL = 12000.0
 
 
@@ -163,10 +170,12 @@ def battery_status(v: VehicleView) -> Any:
 
 
 def ekf_status_report(v: VehicleView) -> Any:
-    """EKF_STATUS_REPORT: attitude and vertical solution good, no horizontal position."""
-    return messages.MAVLink_ekf_status_report_message(
-        EKF_FLAGS_ATTITUDE_VERT, 0.05, 0.0, 0.05, 0.0, 0.0
-    )
+    """EKF_STATUS_REPORT: attitude and vertical solution; a horizontal position only with a GPS."""
+    flags = EKF_FLAGS_GPS if v.autopilot.options.gps else EKF_FLAGS_NO_GPS
+    if v.cache.rangefinder.valid:
+        flags |= EKF_FLAG_POS_VERT_AGL
+    pos_var = 0.05 if v.autopilot.options.gps else 0.0
+    return messages.MAVLink_ekf_status_report_message(flags, 0.05, pos_var, 0.05, 0.0, 0.0)
 
 
 def vibration(v: VehicleView) -> Any:

@@ -6,6 +6,20 @@ but gravity, and the floor's push is up (−z in FRD).
 Thesis eq. 5.1 writes Acceleration = (9.81 / LSB)·1000, which is not a conversion from counts.
 The MPU-6050 gives counts with a sensitivity of 32768 / full-scale LSB per g (16384 at ±2 g),
 so a = counts · g · full_scale_g / 32768; that is what `acc_b` holds.
+
+`acc_b` is one sample as a ground station receives it (RAW_IMU): the rotors' vibration is in it
+whole, as white noise at the output rate. The flight controller does not read the sensor that
+way: its driver takes every sample at the sensor's own rate through the low-pass filter (the
+MPU's DLPF on the APM 2.5, INS_ACCEL_FILTER on 4.x) and averages them over its loop, so rotor
+vibration, at the rotor frequency (>= 100 Hz), leaves only a residue (`vibration_residue`) in
+what its estimator and controllers integrate; the white noise of the sensor itself stays
+whole. Were the vibration integrated as white noise, any inertial estimator corrected by a
+slow baro (3.2.1's third-order filter with INAV_TC_Z 5 s, 4.x's EKF) would wander by
+centimetres, where the firmware on its simulators holds to a millimetre. `acc_fw_b` is that
+reading, from the same random draws (so what a station receives is unchanged), and not
+clipped at the ±2 g the station's samples are scaled to: the firmware configures its own
+range, which `Autopilot` applies (to its vertical navigation and altitude control; its attitude
+estimator keeps `acc_b`, which is only noisier).
 """
 
 from __future__ import annotations
@@ -34,6 +48,7 @@ class ImuSample:
     acc_raw: Counts3  # int16 counts
     gyro_raw: Counts3  # int16 counts
     temperature_c: float
+    acc_fw_b: Vec3  # m/s², what the firmware's driver averages over its loop (see above)
 
 
 def _quantise(value: float, lsb: float) -> int:
@@ -64,14 +79,20 @@ class ImuModel:
         prm = self.params
         ax, ay, az = f_b
         gx, gy, gz = omega_b
+        fx, fy, fz = f_b
         if self.noise:
             n = self.rng.standard_normal(6).tolist()
-            sa = math.hypot(prm.acc_noise_mps2, prm.acc_vibration_mps2_full * rotor_speed_frac)
+            vib = prm.acc_vibration_mps2_full * rotor_speed_frac
+            sa = math.hypot(prm.acc_noise_mps2, vib)
+            sf = math.hypot(prm.acc_noise_mps2, prm.vibration_residue * vib)
             sg = math.hypot(prm.gyro_noise_radps, prm.gyro_vibration_radps_full * rotor_speed_frac)
             ba, bg = self.acc_bias, self.gyro_bias
             ax += ba[0] + sa * n[0]
             ay += ba[1] + sa * n[1]
             az += ba[2] + sa * n[2]
+            fx += ba[0] + sf * n[0]
+            fy += ba[1] + sf * n[1]
+            fz += ba[2] + sf * n[2]
             gx += bg[0] + sg * n[3]
             gy += bg[1] + sg * n[4]
             gz += bg[2] + sg * n[5]
@@ -85,4 +106,5 @@ class ImuModel:
             acc_raw=acc_raw,
             gyro_raw=gyro_raw,
             temperature_c=prm.temperature_c,
+            acc_fw_b=(fx, fy, fz),
         )

@@ -13,17 +13,19 @@ import csv
 import dataclasses
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
 from sitl.autopilot import FlightMode, Profile
 from sitl.simulation import Simulation
 from sitl.world import World, default_world
 from tests.fixture_paths import FIXTURES
-from tests.sitl.flight_helpers import Pilot, arm
-from tests.sitl.gcs_peer import MemoryGcs, mavlink
+from tests.sitl.flight_helpers import HOVER_STICK_US, Pilot, arm
+from tests.sitl.gcs_peer import MemoryGcs
 
 STEPS_US = (1500, 1550, 1600, 1700, 1500, 1450, 1400, 1300, 1500, 1900, 1500, 1100, 1500)
 STEP_S = 4.0
@@ -113,6 +115,22 @@ class SitlFlight:
     ranges: list[tuple[float, float, int]]  # (truth height, RANGEFINDER m, DISTANCE_SENSOR cm)
 
 
+def _climb_in_stabilize(
+    fly: Callable[[float], None], pilot: Pilot, times: list[float], alts: list[float]
+) -> None:
+    """The throttle a station flies to ~1.5 m in STABILIZE from the true height: a PID about
+    mid stick, 20 s (the fixture stations hovered 25 s), ending steady to a millimetre."""
+    integral = 0.0
+    for _ in range(1000):
+        alt = alts[-1] if alts else 0.0
+        climb = (alts[-1] - alts[-3]) / (times[-1] - times[-3]) if len(alts) > 2 else 0.0
+        err = HOLD_ALT_M - alt
+        integral = min(250.0, max(-250.0, integral + 60.0 * err * 0.02))
+        us = HOVER_STICK_US + 150.0 * err - 120.0 * climb + integral
+        pilot.sticks[2] = round(min(1700.0, max(1300.0, us)))
+        fly(0.02)
+
+
 def tall_world() -> World:
     """A 40 x 40 x 14 m hall: the steps climb about 7 m over the hold (4.7 to 8.9 m)."""
     return dataclasses.replace(
@@ -122,10 +140,18 @@ def tall_world() -> World:
 
 def fly_steps(
     profile: Profile, seed: int = 1, noise: bool = True, settle_s: float = 6.0,
-    steps: tuple[int, ...] = STEPS_US,
+    steps: tuple[int, ...] = STEPS_US, climb_in_stabilize: bool = False,
+    world: World | None = None,
 ) -> SitlFlight:
-    """Arm in STABILIZE, climb to ~1.5 m, ALT_HOLD at 1500 µs, then the fixture's steps."""
-    sim = Simulation(tall_world(), profile, 1, seed=seed, noise=noise)
+    """Arm in STABILIZE, climb to ~1.5 m, ALT_HOLD at 1500 µs, then the fixture's steps.
+
+    The climb is on the stick in ALT_HOLD, or (`climb_in_stabilize`) as the fixture stations
+    flew it: on the throttle in STABILIZE, ALT_HOLD engaged at 1500 µs once steady. The two
+    differ for 3.2.1's surface tracking: engaged in the hover, its sonar target is the reading
+    then; after a climb in ALT_HOLD it is wherever the stick's rate left it, between two of the
+    analog sonar's 6 cm steps, and the hold dithers across the step (0.4-0.5 cm), as the
+    firmware's own arithmetic does. `world` replaces the tall hall (its sensors, say)."""
+    sim = Simulation(world or tall_world(), profile, 1, seed=seed, noise=noise)
     gcs = MemoryGcs(sim, sim.memory_link(1), mavlink1=profile is Profile.APM25)
     gcs.heartbeat()
     gcs.send(mavlink.MAVLink_request_data_stream_message(1, 1, 0, 10, 1))
@@ -153,13 +179,17 @@ def fly_steps(
 
     ack = arm(gcs, pilot)
     assert ack.result == 0, ack
-    # climb in ALT_HOLD on the stick (as the fixture stations reached ~1.5 m), then centre it
-    gcs.set_mode(1, int(FlightMode.ALT_HOLD))
-    pilot.sticks[2] = 1700
-    while not alts or alts[-1] < HOLD_ALT_M - 0.15:
-        fly(0.02)
-        if sim.t_s > 60.0:
-            raise AssertionError("the SITL did not climb in ALT_HOLD")
+    if climb_in_stabilize:
+        _climb_in_stabilize(fly, pilot, times, alts)
+        gcs.set_mode(1, int(FlightMode.ALT_HOLD))
+    else:
+        # climb in ALT_HOLD on the stick, then centre it
+        gcs.set_mode(1, int(FlightMode.ALT_HOLD))
+        pilot.sticks[2] = 1700
+        while not alts or alts[-1] < HOLD_ALT_M - 0.15:
+            fly(0.02)
+            if sim.t_s > 60.0:
+                raise AssertionError("the SITL did not climb in ALT_HOLD")
     pilot.sticks[2] = 1500
     fly(settle_s)
     starts: list[tuple[float, int]] = []
