@@ -30,11 +30,34 @@ _KEPT_FIELDS = {
 }
 
 
-def _message_name(msg_id: float) -> str:
+_V1, _V2 = 0xFE, 0xFD
+# what a tlog's vehicle frames must be decoded for (the rest count only by their header)
+_DECODED_RX = frozenset({"HEARTBEAT", "RAW_IMU", "VFR_HUD", "SYS_STATUS", "STATUSTEXT",
+                         "COMMAND_ACK", "SIMSTATE", "SIM_STATE", "ATT_POS_MOCAP"})
+
+
+def _mavlink_map() -> dict[int, Any]:
     from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
-    cls = mavlink.mavlink_map.get(int(msg_id))
+    return dict(mavlink.mavlink_map)
+
+
+def _message_name(msg_id: float) -> str:
+    cls = _mavlink_map().get(int(msg_id))
     return str(cls.msgname) if cls is not None else str(int(msg_id))
+
+
+def _header(data: bytes, names: dict[int, Any]) -> tuple[int, int, int, str] | None:
+    """(seq, sysid, compid, message name) from a frame's header, None for no frame."""
+    if len(data) >= 8 and data[0] == _V1:
+        seq, sysid, compid, msg_id = data[2], data[3], data[4], data[5]
+    elif len(data) >= 12 and data[0] == _V2:
+        seq, sysid, compid = data[4], data[5], data[6]
+        msg_id = data[7] | (data[8] << 8) | (data[9] << 16)
+    else:
+        return None
+    cls = names.get(msg_id)
+    return seq, sysid, compid, str(cls.msgname) if cls is not None else str(msg_id)
 
 
 def gather(recording: Recording) -> FlightSeries:
@@ -46,6 +69,7 @@ def gather(recording: Recording) -> FlightSeries:
     wanted = sorted((TOPICS & have) | (set(RAW_TOPICS) & have))
     readers = {d: FrameReader(make_parser(255, 190)) for d in ("rx", "tx")}
     converter = RecordConverter()
+    names = _mavlink_map()
     for topic, log_ns, message in recording.messages(wanted):
         t_s = (log_ns - start_ns) / 1e9
         if topic not in RAW_TOPICS:
@@ -56,6 +80,13 @@ def gather(recording: Recording) -> FlightSeries:
             data = base64.b64decode(message["data"], validate=True)
         except (KeyError, TypeError, ValueError):
             continue  # a frame without its bytes is dropped, as a bad byte on a link
+        head = _header(data, names)
+        if head is None:
+            continue
+        seq, sysid, compid, kind = head
+        if direction == "rx" and (station or kind not in _DECODED_RX):
+            fs.frame(FrameInfo(t_s, direction, sysid, compid, seq, kind))
+            continue
         for msg in readers[direction].parse(data):
             _take(fs, msg, direction, t_s, converter if not station else None)
     return fs

@@ -67,7 +67,10 @@ def control_metrics(fs: FlightSeries) -> dict[str, Measured]:
     out: dict[str, Measured] = {}
     c = fs.control
     if len(c):
-        fly = flying(fs, c["t"])
+        # the hold's ticks where the supervisor says so (a take-off climbs at full authority
+        # by design); otherwise every tick in the air
+        holds = state_intervals(fs, frozenset({"hold"}))
+        fly = in_intervals(c["t"], holds) if holds else flying(fs, c["t"])
         n = int(fly.sum())
         if n:
             alt = fs.setup.get("altitude", {})
@@ -75,9 +78,10 @@ def control_metrics(fs: FlightSeries) -> dict[str, Measured]:
             hi = float(alt.get("throttle_max_us", 2000))
             thr = c["throttle_us"][fly]
             sat = int(np.sum((thr >= hi - 1) | (thr <= lo + 1)))
+            where = "in the hold" if holds else "in the air"
             out["control.stick_limit_pct"] = Measured(
-                100.0 * sat / n, f"{sat} of {n} controller ticks in the air at "
-                f"{lo:.0f} or {hi:.0f} µs")
+                100.0 * sat / n, f"{sat} of {n} controller ticks {where} at {lo:.0f} or "
+                f"{hi:.0f} µs")
             gains = fs.setup.get("altitude", {}).get("gains", {})
             i_max = float(gains.get("i_max", math.nan))
             if math.isfinite(i_max) and i_max > 0:
@@ -85,7 +89,6 @@ def control_metrics(fs: FlightSeries) -> dict[str, Measured]:
                 out["control.integrator_limit_pct"] = Measured(
                     100.0 * at / n,
                     f"{at} of {n} ticks with |I| ≥ {INTEGRATOR_AT_LIMIT:g}·{i_max:g}")
-        holds = state_intervals(fs, frozenset({"hold"}))
         inside = in_intervals(c["t"], [(a + HOVER_SKIP_S, b) for a, b in holds if b - a > 2 *
                                        HOVER_SKIP_S])
         hover = c["hover"][inside & np.isfinite(c["hover"])]
