@@ -15,7 +15,7 @@ from logs.check.timeline import flying, held, in_intervals, rms, state_intervals
 
 VIBE_WINDOW_S = 1.0  # vibration is what the accelerometer does about its mean over this long
 THROTTLE_BANDS_PCT = (0.0, 25.0, 50.0, 75.0, 100.01)
-MIN_BAND_SAMPLES = 20
+MIN_BAND_S = 2.0  # a band is judged on this much flying in it, not on a take-off's burst
 INTEGRATOR_AT_LIMIT = 0.98  # |I| at this share of its limit or more is "at the limit"
 HOVER_SKIP_S = 5.0  # the hover throttle is still being learned this long into a hold
 FAILSAFE_MODES = {6: "RTL", 9: "LAND"}  # a change into these nobody asked for is a failsafe
@@ -52,7 +52,7 @@ def vibration_metrics(fs: FlightSeries) -> dict[str, Measured]:
         bands = []
         for lo, hi in itertools.pairwise(THROTTLE_BANDS_PCT):
             sel = fly & (thr >= lo) & (thr < hi)
-            if sel.sum() >= MIN_BAND_SAMPLES:
+            if sel.sum() >= max(MIN_BAND_S * rate_hz, 20):
                 bands.append((rms(total[sel]), f"{lo:.0f}-{min(hi, 100):.0f} %"))
         if bands:
             value, band = max(bands)

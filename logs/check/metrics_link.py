@@ -30,20 +30,39 @@ def link_metrics(fs: FlightSeries) -> dict[str, Measured]:
     out["link.loss_pct"] = Measured(100.0 * lost / max(got + lost, 1),
                                     f"{lost} lost of {got + lost} frames (sequence gaps)")
     t = np.sort(np.asarray(fs.rx_times))
-    # before any stream is asked for a vehicle sends only heartbeats: not a silence of the link
+    # before any stream is asked for a vehicle sends only heartbeats, and a team's stations
+    # come up one after the other: silences that matter are those of an armed vehicle
     start = min((a for a, _w, _r in fs.rates_asked), default=t[0]) + RATE_SETTLE_S
-    t = t[t >= start]
+    end = t[-1]
+    span = armed_span(fs)
+    if span is not None:
+        start, end = max(start, span[0]), span[1]
+    t = t[(t >= start) & (t <= end)]
     if t.size > 1:
         d = np.diff(t)
         big = d > GAP_S
         out["link.gaps"] = Measured(float(big.sum()), f"silences over {GAP_S:g} s from "
-                                    f"{start:.1f} s to {t[-1]:.1f} s")
+                                    f"{start:.1f} s to {end:.1f} s")
         i = int(np.argmax(d))
         out["link.longest_silence_s"] = Measured(float(d[i]), f"at {t[i]:.1f} s")
     rate = _stream_rates(fs)
     if rate is not None:
         out["link.stream_rate_pct"] = rate
     return out
+
+
+def armed_span(fs: FlightSeries) -> tuple[float, float] | None:
+    """From the first heartbeat that says armed to the first disarmed one after the last armed
+    one (or the end), None if never armed."""
+    hb = fs.heartbeat
+    if not len(hb):
+        return None
+    armed = np.flatnonzero(hb["armed"] > 0.5)
+    if not armed.size:
+        return None
+    last = int(armed[-1])
+    end = float(hb["t"][last + 1]) if last + 1 < len(hb) else fs.duration_s
+    return float(hb["t"][armed[0]]), end
 
 
 def _stream_rates(fs: FlightSeries) -> Measured | None:

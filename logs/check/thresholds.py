@@ -66,10 +66,10 @@ DEFAULTS: tuple[Threshold, ...] = (
        "ticks that took longer than their period or woke a whole period late: missed commands"),
     _t("loop.late_ticks_pct", "%", 0.5, 2.0, "high",
        "ticks that woke more than half a period late: stale sticks on the vehicle"),
-    _t("estimator.innovation_rms_m", "m", 0.05, 0.15, "high",
+    _t("estimator.innovation_rms_m", "m", 0.08, 0.2, "high",
        "sonar minus prediction: large innovations mean a model or sensor the estimator "
        "does not believe"),
-    _t("estimator.rejected_pct", "%", 15.0, 30.0, "high",
+    _t("estimator.rejected_pct", "%", 25.0, 40.0, "high",
        "sonar readings the gate refused: the hold then flies on the accelerometer"),
     _t("estimator.vs_reference_rms_m", "m", 0.12, 0.25, "high",
        "the altitude estimate against ground truth or motion capture: what the controller "
@@ -81,14 +81,14 @@ DEFAULTS: tuple[Threshold, ...] = (
     _t("vibration.acc_rms_z_mps2", "m/s²", 1.5, 3.0, "high",
        "accelerometer noise about its 1 s mean while flying, down axis: the altitude "
        "estimator integrates this one"),
-    _t("vibration.worst_throttle_band_mps2", "m/s²", 2.0, 4.0, "high",
+    _t("vibration.worst_throttle_band_mps2", "m/s²", 3.0, 5.0, "high",
        "the noisiest throttle band (25 % bands): vibration that grows with throttle is a "
        "prop or motor"),
     _t("control.stick_limit_pct", "%", 2.0, 10.0, "high",
        "time the throttle sat at its limit in the air: the controller had no authority left"),
     _t("control.integrator_limit_pct", "%", 2.0, 10.0, "high",
        "time the altitude integrator sat at its limit: a trim it could not find"),
-    _t("control.hover_drift_pct", "% thr", 5.0, 10.0, "high",
+    _t("control.hover_drift_pct", "% thr", 8.0, 15.0, "high",
        "how far the learned hover throttle moved while flying: a draining battery or a "
        "changing load"),
     _t("power.sag_v_per_a", "V/A", 0.06, 0.12, "high",

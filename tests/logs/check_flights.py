@@ -6,7 +6,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from gcs.errors import FlightFailed
+
+HOLD_S = 5.0
 
 
 def fly_recorded(out: Path, *, seed: int = 1, profile: str = "apm25", hold_s: float = 10.0,
@@ -56,3 +60,11 @@ def starve(every: int = 5, extra_s: float = 0.04) -> Callable[[Any], None]:
         station.add_listener(slow)
 
     return install
+
+
+@pytest.fixture(scope="session")
+def clean_flight(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A clean 5 s lockstep hold, recorded (flown once for every test that reads it)."""
+    path, summary = fly_recorded(tmp_path_factory.mktemp("clean") / "fly.mcap", hold_s=HOLD_S)
+    assert summary["status"] == "ok", summary
+    return path

@@ -5,13 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
-
 from gcs.flight_check import gather_file
 from logs.check import CheckResult, Status, evaluate, load_thresholds, measure
-from tests.logs.check_flights import fly_recorded, starve
-
-HOLD_S = 5.0
+from tests.logs.check_flights import HOLD_S, fly_recorded, starve
 
 
 def check(path: Path) -> dict[str, CheckResult]:
@@ -19,15 +15,8 @@ def check(path: Path) -> dict[str, CheckResult]:
     return {r.key: r for r in results}
 
 
-@pytest.fixture(scope="module")
-def clean(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    path, summary = fly_recorded(tmp_path_factory.mktemp("clean") / "fly.mcap", hold_s=HOLD_S)
-    assert summary["status"] == "ok", summary
-    return path
-
-
-def test_a_clean_lockstep_hold_fails_nothing_and_measures_every_group(clean: Path) -> None:
-    results = check(clean)
+def test_a_clean_lockstep_hold_fails_nothing_and_measures_every_group(clean_flight: Path) -> None:
+    results = check(clean_flight)
     bad = {k: (r.status, r.value, r.detail) for k, r in results.items()
            if r.status in (Status.FAIL, Status.WARN)}
     assert not bad
