@@ -27,6 +27,7 @@ from collections.abc import Callable
 from firmware_link.records import (
     CommandAck,
     Heartbeat,
+    Imu,
     LinkEvent,
     LinkEventKind,
     StatusText,
@@ -40,6 +41,7 @@ from gcs.core.flight_core import FlightCore
 from gcs.core.inputs import NEVER_S, TickInputs
 from gcs.core.landing import may_leave, must_land
 from gcs.estimation import AltEstimator
+from gcs.live_check import LiveCheck
 from gcs.station.execute import send_decision
 from gcs.station.exit import emergency_land, let_go
 from gcs.station.intents import STICK_MAX_US, STICK_MIN_US, StationIntents
@@ -60,13 +62,18 @@ from gcs.station.types import (
     control_mode,
 )
 from gcs.supervisor import (
+    AIRBORNE_CAPABLE,
     Intent,
     IntentKind,
     Outcome,
     Supervisor,
     SupervisorParams,
+    SupervisorState,
     VehicleStatus,
 )
+
+# armed and off the floor or leaving it: where vibration means something
+_FLYING = AIRBORNE_CAPABLE - {SupervisorState.ARMING, SupervisorState.SPOOL_UP}
 
 __all__ = [
     "STICK_MAX_US",
@@ -119,6 +126,7 @@ class Station(StationIntents):
         self._listeners: list[Callable[[StationSnapshot], None]] = []
         self._record_listeners: list[Callable[[TelemetryRecord], None]] = []
         self._listener_errors = 0
+        self.live_check = LiveCheck()  # logs check's cheap part, told to the pilot as it flies
         self._last_rx_s = -NEVER_S
         self._heartbeats_on = True
         self._empty_stats = self.loop.stats()
@@ -324,6 +332,9 @@ class Station(StationIntents):
         if self.recorder is not None:
             record_tick(self.recorder, inputs, out, self.loop.last_timing)
         snap = self._make_snapshot(t_s, k)
+        for text in self.live_check.tick(t_s, snap.armed and snap.state in _FLYING,
+                                         snap.link_stats, self.loop.last_timing):
+            self._event(t_s, EventLevel.WARNING, text)
         with self._lock:
             self._snapshot = snap
         for fn in self._listeners:
@@ -361,6 +372,8 @@ class Station(StationIntents):
                 topic = topics.topic_for(r)
                 if topic is not None:
                     rec.put(topic, r.t_s, r)
+            if isinstance(r, Imu):
+                self.live_check.imu(r)
             if isinstance(r, LinkEvent):
                 level = EventLevel.ERROR if r.kind is LinkEventKind.LOST else EventLevel.INFO
                 self._event(r.t_s, level, f"link {r.kind.value}: {r.detail}")
