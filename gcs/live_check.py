@@ -138,13 +138,15 @@ class LiveCheck:
 
     def _judge(self, t_s: float) -> list[str]:
         out: list[str] = []
+        full = len(self._link) == self._link.maxlen  # a whole 10 s window: judged on it only
         loss = self.loss_pct()
-        if len(self._link) == self._link.maxlen:
+        if full:
             self._worst_loss_pct = max(self._worst_loss_pct, loss)
-        if judge(loss, self.loss) is not Status.PASS:
+        if full and judge(loss, self.loss) is not Status.PASS:
             self._tell("loss", t_s, f"link loss {loss:.0f} % over {WINDOW_S:.0f} s", out)
         (_t0, n0, o0), (_t1, n1, o1) = self._ticks[0], self._ticks[-1]
-        if n1 > n0 and judge(100.0 * (o1 - o0) / (n1 - n0), self.overruns) is not Status.PASS:
+        overrun_pct = 100.0 * (o1 - o0) / max(n1 - n0, 1)
+        if full and judge(overrun_pct, self.overruns) is not Status.PASS:
             self._tell("loop", t_s, f"loop overruns: {o1 - o0} of {n1 - n0} ticks in the last "
                        f"{WINDOW_S:.0f} s", out)
         if self._flying and self._v.flown_s > POWER_TC_S:
