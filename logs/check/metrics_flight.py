@@ -232,8 +232,32 @@ def hold_metrics(fs: FlightSeries) -> dict[str, Measured]:
         return {}
     mean = float(err.mean())
     note = f"{t1 - t0:.1f} s from {t0:.1f} s, {err.size} {source} samples"
-    return {
+    out = {
         "hold.rms_m": Measured(rms(err), note, source),
         "hold.bias_m": Measured(abs(mean), f"mean {mean:+.3f} m; {note}", source),
         "hold.std_m": Measured(float(err.std()), note, source),
     }
+    sel = (c["t"] >= t0) & (c["t"] <= t1) & np.isfinite(c["error"])
+    memory = error_memory_s(c["t"][sel], c["error"][sel])
+    if math.isfinite(memory):
+        out["hold.error_memory_s"] = Measured(
+            memory, f"the controller's error (setpoint - estimate) over {t1 - t0:.1f} s",
+            "estimate")
+    return out
+
+
+def error_memory_s(t: np.ndarray, e: np.ndarray) -> float:
+    """How long an error lasts: the lag at which its autocorrelation first falls below 1/e
+    (NaN for too short a record). A stiff hold corrects within a few tenths of a second; a
+    soft one (low gains) lets each error linger."""
+    if e.size < 40:
+        return math.nan
+    dt = float(np.median(np.diff(t)))
+    x = e - e.mean()
+    n = 1 << int(np.ceil(np.log2(2 * x.size)))
+    spectrum = np.fft.rfft(x, n)
+    ac = np.fft.irfft(spectrum * np.conj(spectrum), n)[: x.size]
+    if ac[0] <= 0.0:
+        return math.nan
+    below = np.flatnonzero(ac / ac[0] < math.exp(-1.0))
+    return float(below[0]) * dt if below.size else math.nan

@@ -109,6 +109,9 @@ DEFAULTS: tuple[Threshold, ...] = (
        "the hold's mean error, absolute: a constant offset"),
     _t("hold.std_m", "m", 0.1, 0.2, "high",
        "the hold's spread about its mean: wandering"),
+    _t("hold.error_memory_s", "s", 1.0, 2.0, "high",
+       "how long a hold error lasts (its autocorrelation falls to 1/e): a soft hold, low "
+       "gains or a weak vehicle, lets each disturbance linger"),
 )
 
 
