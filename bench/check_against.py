@@ -12,8 +12,11 @@ metrics flagged beyond the campaign's worst run, and hold.error_memory_s's perce
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/ shadows packages
 
 from gcs.flight_check import gather_file
 from lab.campaign.results import RESULTS_NAME, read_results

@@ -9,9 +9,13 @@ Prints µs per tick (mean, and of the slowest of 1000-tick blocks); the loop's b
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/ shadows packages
 
 from firmware_link.records import Imu
 from firmware_link.stats import LinkStats
