@@ -19,7 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/ shadows p
 
 from firmware_link.records import Imu
 from firmware_link.stats import LinkStats
-from gcs.live_check import LiveCheck
+from gcs.station.live_check import LiveCheck
 from gcs.station.loop import TickTiming
 
 PERIOD_S = 0.025

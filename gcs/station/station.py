@@ -41,10 +41,10 @@ from gcs.core.flight_core import FlightCore
 from gcs.core.inputs import NEVER_S, TickInputs
 from gcs.core.landing import may_leave, must_land
 from gcs.estimation import AltEstimator
-from gcs.live_check import LiveCheck
 from gcs.station.execute import send_decision
 from gcs.station.exit import emergency_land, let_go
 from gcs.station.intents import STICK_MAX_US, STICK_MIN_US, StationIntents
+from gcs.station.live_check import LiveCheck
 from gcs.station.loop import FixedRateLoop
 from gcs.station.record import record_tick
 from gcs.station.snapshot import make_snapshot

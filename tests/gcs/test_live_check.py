@@ -10,7 +10,7 @@ import numpy as np
 
 from firmware_link.records import Imu
 from firmware_link.stats import LinkStats
-from gcs.live_check import LiveCheck
+from gcs.station.live_check import LiveCheck
 from gcs.station.loop import TickTiming
 from logs import open_recording
 from logs.check import Status
