@@ -98,3 +98,15 @@ def test_the_real_firmware_tlogs_are_checked_directly_and_imported(
     assert code == 0
     assert {k: (c["status"], c["value"]) for k, c in imported.items()} == \
         {k: (c["status"], c["value"]) for k, c in direct.items()}
+
+
+def test_a_recording_cut_short_by_a_killed_station_is_checked_from_its_whole_chunks(
+        clean_flight: Path, capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    data = clean_flight.read_bytes()
+    cut = tmp_path / "killed.mcap"
+    cut.write_bytes(data[: len(data) * 6 // 10])  # no summary, no index, a torn last chunk
+    code, out, _ = _run(capsys, str(cut), "--json")
+    assert code in (0, 1)
+    rows = {c["check"]: c for c in json.loads(out)["files"][0]["checks"]}
+    assert rows["link.loss_pct"]["status"] == "PASS"
+    assert rows["loop.overruns_pct"]["status"] == "PASS"
