@@ -110,3 +110,27 @@ def test_a_recording_cut_short_by_a_killed_station_is_checked_from_its_whole_chu
     rows = {c["check"]: c for c in json.loads(out)["files"][0]["checks"]}
     assert rows["link.loss_pct"]["status"] == "PASS"
     assert rows["loop.overruns_pct"]["status"] == "PASS"
+
+
+@pytest.mark.parametrize(("name", "said"), [
+    # the uplink dropped for 15 s in a hold: 3.2.1's GCS failsafe picks RTL at T0 + 5.07 s …
+    ("arducopter-3.2.1-uplink-fade.tlog", "RTL at 40.1 s unasked"),
+    # … 4.7 (FS_OPTIONS 16) continues in STABILIZE and says so
+    ("arducopter-4.7dev-uplink-fade.tlog", "GCS Failsafe - Continuing Pilot Control"),
+    # heartbeats stopped for 10 s at the end: 3.2.1 goes to RTL, 4.7 disarms on the floor
+    ("arducopter-3.2.1-althold-steps.tlog", "RTL at 103.1 s unasked"),
+    ("arducopter-4.7dev-althold-steps.tlog", "GCS Failsafe - Disarming"),
+])
+def test_the_real_firmwares_failsafes_fail_the_events(
+        name: str, said: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """The fixtures' failsafes (their README tells when and how each acted) are found."""
+    tlog = FIXTURES / name
+    if not tlog.exists():
+        pytest.skip(f"{tlog} is not here (it comes with ../shared/fixtures)")
+    code, out, _ = _run(capsys, str(tlog), "--json")
+    rows = {c["check"]: c for c in json.loads(out)["files"][0]["checks"]}
+    assert code == 1
+    assert rows["events.failsafes"]["status"] == "FAIL" and rows["events.failsafes"]["value"] == 1
+    assert said in rows["events.failsafes"]["detail"]
+    failed = {k for k, c in rows.items() if c["status"] == "FAIL"}
+    assert failed == {"events.failsafes"}
