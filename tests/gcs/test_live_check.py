@@ -93,12 +93,21 @@ def test_a_fault_in_it_is_told_once_and_never_raises() -> None:
 
 
 def test_a_vibrating_imu_is_told_in_flight_and_summed_up(tmp_path: Path) -> None:
+    """In the recording's events, and in the messages the TUI shows (its station backend)."""
+    from gcs.tui.station_backend import StationBackend
     from tests.logs.check_flights import fly_recorded
 
-    path, summary = fly_recorded(tmp_path / "vibe.mcap", hold_s=5.0,
+    backends: list[StationBackend] = []
+
+    def watch(session: Any) -> None:
+        backends.append(StationBackend(session.first.station))
+
+    path, summary = fly_recorded(tmp_path / "vibe.mcap", hold_s=5.0, during=watch,
                                  world={"sensors": {"imu": {"acc_vibration_mps2_full": 6.0}}})
     events = [m["text"] for _t, _ns, m in open_recording(path).messages(["/gcs/events"])]
     assert any(text.startswith("vibration high") for text in events), events
     assert not any(text.startswith("link loss") for text in events)
+    shown = [text for _t, text in backends[0].view().messages]
+    assert any(text.startswith("vibration high") for text in shown), shown
     if summary["status"] == "ok":
         assert summary["live_checks"].startswith("live checks FAIL")
