@@ -31,6 +31,7 @@ def test_every_mission_kinds_recordings_are_checked(mission: str, tmp_path: Path
                  "1", "-o", str(tmp_path), "--json"])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0, summary
+    assert "live checks PASS" in json.dumps(summary)  # the station's own summary line
     recordings = sorted(tmp_path.glob("*.mcap"))
     assert recordings
     for path in recordings:
