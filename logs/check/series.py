@@ -193,7 +193,9 @@ class FlightSeries:
             what = f"stream:{int(_num(fields.get('req_stream_id')))}"
             self.rates_asked.append((f.t_s, what, _num(fields.get("req_message_rate"))))
         elif f.msg_type == "RC_CHANNELS_OVERRIDE":
-            self.tx_overrides.add(t=f.t_s, throttle_us=_num(fields.get("chan3_raw")))
+            thr = _num(fields.get("chan3_raw"))
+            # 0 releases the channel and UINT16_MAX leaves it alone: no throttle was sent
+            self.tx_overrides.add(t=f.t_s, throttle_us=thr if 0 < thr < 65535 else math.nan)
 
 
 _TOPICS = {
