@@ -11,9 +11,9 @@ from typing import Any
 
 from gcs.errors import UsageError
 from gcs.flight_check import gather_file
-from logs import RecordingError
+from logs import RecordingError, open_recording
 from logs.check import Status, ThresholdError, evaluate, load_thresholds, measure, worst
-from logs.check.against import format_placements, place
+from logs.check.against import format_placements, place, settings_differences
 from logs.check.html import write_html
 from logs.check.table import format_table, to_json
 
@@ -54,6 +54,23 @@ def read_campaign(path: Path) -> list[dict[str, Any]]:
     return rows
 
 
+def campaign_settings(path: Path, rows: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The station settings the campaign flew (its first kept recording's `/gcs/setup`), and
+    None when it kept none."""
+    root = path if path.is_dir() else path.parent
+    for row in rows:
+        recording = root / "flights" / f"{row.get('run_id')}.mcap"
+        if row.get("status") != "ok" or not recording.is_file():
+            continue
+        try:
+            for _topic, _ns, message in open_recording(recording).messages(["/gcs/setup"]):
+                config = json.loads(str(message.get("config_json", "{}")))
+                return config if isinstance(config, dict) else None
+        except (RecordingError, ValueError):
+            continue
+    return None
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """Check every file; print the tables (or JSON); write the HTML report if asked."""
     try:
@@ -61,6 +78,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     except ThresholdError as exc:
         raise UsageError(str(exc)) from exc
     campaign = read_campaign(args.against) if args.against is not None else None
+    settings = campaign_settings(args.against, campaign) if campaign is not None else None
+    varied = sorted({k for row in campaign or [] for k in row if k.startswith("station.")})
     reports: list[dict[str, Any]] = []
     texts: list[str] = []
     pages = []
@@ -78,11 +97,16 @@ def cmd_check(args: argparse.Namespace) -> int:
         placements = None
         if campaign is not None:
             placements = place(measured, campaign, table)
+            differ = (settings_differences(fs.setup, settings, varied)
+                      if settings is not None and fs.setup else [])
             report["against"] = {"campaign": str(args.against),
                                  "flagged": sum(p.flagged for p in placements),
+                                 "settings_differ": differ,
                                  "metrics": [p.to_dict() for p in placements]}
             text += "\n" + format_placements(str(args.against), placements)
-            failed |= any(p.flagged for p in placements)
+            if differ:
+                text += ("\n  settings differ from the campaign's: " + "; ".join(differ))
+            failed |= any(p.flagged for p in placements) or bool(differ)
         reports.append(report)
         texts.append(text)
         pages.append((str(path), fs, results, placements))

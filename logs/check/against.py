@@ -5,6 +5,7 @@ check metrics of that run's recording as `check.<key>` columns (and the flight s
 columns). For each metric both have, the flight's percentile among the campaign's runs is given,
 and the flight is flagged when it lies beyond the campaign's worst run on the metric's bad side
 (its threshold's `worse`). A metric with fewer than `MIN_RUNS` values in the campaign is left out.
+The flight's station settings are compared with the campaign's too (`settings_differences`).
 """
 
 from __future__ import annotations
@@ -21,6 +22,9 @@ from logs.check.thresholds import Threshold
 
 COLUMN_PREFIX = "check."
 MIN_RUNS = 3
+# settings of the process, not of the flight: a real flight at real-time priority compares
+# fairly with a lockstep campaign that runs without it
+NOT_FLIGHT_SETTINGS = frozenset({"realtime_priority", "gil_switch_interval_s", "events_kept"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -96,3 +100,38 @@ def format_placements(campaign: str, placements: Sequence[Placement]) -> str:
 def check_columns(measured: Mapping[str, Measured]) -> dict[str, float]:
     """A run's metrics as the campaign's row columns (`check.<key>`)."""
     return {COLUMN_PREFIX + k: m.value for k, m in measured.items() if not math.isnan(m.value)}
+
+
+def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            out.update(_flatten(value, name + "."))
+        else:
+            out[name] = value
+    return out
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, int | float) and isinstance(b, int | float):
+        return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-12)
+    return bool(a == b)
+
+
+def settings_differences(flight: Mapping[str, Any], campaign: Mapping[str, Any],
+                         varied: Sequence[str] = ()) -> list[str]:
+    """The station settings (a recording's `/gcs/setup` configuration) in which the flight
+    differs from the campaign's runs, other than those the campaign itself varied (its
+    `station.*` axes): "altitude.gains.kp 4.5 (campaign 9)". Comparing a flight with a
+    campaign flown otherwise compares two different stations."""
+    mine, theirs = _flatten(flight), _flatten(campaign)
+    skip = {v.removeprefix("station.") for v in varied} | NOT_FLIGHT_SETTINGS
+    out = []
+    for key in sorted(set(mine) | set(theirs)):
+        if key in skip:
+            continue
+        a, b = mine.get(key), theirs.get(key)
+        if not _same(a, b):
+            out.append(f"{key} {a!r} (campaign {b!r})")
+    return out
