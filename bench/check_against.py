@@ -18,6 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/ shadows packages
 
+from gcs.commands.logs_check import campaign_settings
 from gcs.flight_check import gather_file
 from lab.campaign.results import RESULTS_NAME, read_results
 from lab.campaign.run import fly_run, make_run
@@ -25,7 +26,7 @@ from lab.campaign.spec import load_campaign
 from lab.campaign.types import BaseFlight
 from lab.cli import main as quadgcs
 from logs.check import load_thresholds, measure
-from logs.check.against import place
+from logs.check.against import place, settings_differences
 
 ROOT = Path(__file__).resolve().parents[1]
 CAMPAIGN = ROOT / "campaigns" / "hold_check_seeds.toml"
@@ -51,6 +52,7 @@ def main() -> None:
     base = load_campaign(CAMPAIGN).base
     assert isinstance(base, BaseFlight)
     table = load_thresholds(None)
+    settings = campaign_settings(args.campaign, rows) or {}
     seeds = [(int(s), "inside") for s in args.inside.split(",")] + \
         [(s, "fresh") for s in _range(args.fresh)]
     print(f"campaign {args.campaign}: {sum(r.get('status') == 'ok' for r in rows)} runs flown")
@@ -62,14 +64,15 @@ def main() -> None:
                 if row["status"] != "ok":
                     print(f"seed {seed:3d} ({where}) {label:12s}: failed: {row['reason']}")
                     continue
-                placed = place(measure(gather_file(Path(tmp) / "flights" / f"{run.run_id}.mcap")),
-                               rows, table)
+                fs = gather_file(Path(tmp) / "flights" / f"{run.run_id}.mcap")
+                placed = place(measure(fs), rows, table)
+                differ = settings_differences(fs.setup, settings)
                 flagged = [pl.key for pl in placed if pl.flagged]
                 memory = next(pl for pl in placed if pl.key == "hold.error_memory_s")
                 print(f"seed {seed:3d} ({where}) {label:12s}: {len(flagged)} flagged "
                       f"{flagged}; error memory {memory.value:.3f} s, percentile "
                       f"{memory.percentile:.0f} (campaign {memory.campaign_best:.3f}-"
-                      f"{memory.campaign_worst:.3f} s)")
+                      f"{memory.campaign_worst:.3f} s); settings differ: {differ or 'no'}")
 
 
 if __name__ == "__main__":
