@@ -23,6 +23,7 @@ EXAMPLES: dict[str, str] = {
     "logs recover": "quadgcs logs recover flights/crashed.mcap",
     "logs plot": "quadgcs logs plot flight.mcap -o flight.png",
     "logs import-tlog": "quadgcs logs import-tlog flight.tlog -o flight.mcap",
+    "logs check": "quadgcs logs check flights/*.mcap --html review.html",
     "bench": "quadgcs bench foxglove_jitter",
     "params": "quadgcs params --connect tcp:127.0.0.1:5760 get THR_MID",
     "params show": "quadgcs params show 'FS_*'",

@@ -202,6 +202,8 @@ def _print_summary(d: dict[str, Any]) -> None:
               f"{f['to_vehicle']} in; refused: {f['refused_overrides']} RC overrides, "
               f"{f['refused_streams']} stream-rate requests, {f['refused_silent']} while "
               f"silent, {f['refused_unsigned']} unsigned")
+    if "live_checks" in d:
+        print(d["live_checks"])
     print(f"recording: {d['recording'] or 'off'}")
 
 
@@ -279,6 +281,7 @@ def fly_session(session: StationSession, plan: FlightPlan, live: bool = False,
     d = _summary_dict(runner.summary(v.truth_series()), path, v.link.firmware)
     d["link_down_s"] = round(v.station.snapshot(loop_stats=False).link_down_s, 3)
     d["hold_mode"] = v.station.config.hold_mode.value
+    d["live_checks"] = v.station.live_check.summary()[1]
     d["status"] = "ok"
     if session.forwarder is not None:
         d["forward"] = dataclasses.asdict(session.forwarder.stats)

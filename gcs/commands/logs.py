@@ -1,4 +1,5 @@
-"""`quadgcs logs info|export|recover|plot|import-tlog`: look into and convert flight recordings."""
+"""`quadgcs logs info|export|recover|plot|import-tlog|check`: look into, convert and review
+flight recordings."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from gcs.commands import logs_check
 from gcs.errors import RuntimeFault, UsageError
 from logs import Recording, RecordingError, open_recording
 from logs.csv_export import export_csv
@@ -53,6 +55,8 @@ def register(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     imp.add_argument("tlog", type=Path, help="MAVLink telemetry log (.tlog)")
     imp.add_argument("-o", "--output", type=Path, required=True, help="output .mcap")
     imp.set_defaults(func=cmd_import_tlog)
+
+    logs_check.register(sub)
 
 
 def _missing_action(parser: argparse.ArgumentParser) -> Callable[[argparse.Namespace], int]:

@@ -109,7 +109,10 @@ def run_on_vehicles(spec: MissionSpec, mw: MissionWorld, setup: PlannerSetup, op
         collisions, truth_metrics = (_truth_books(crafts, mw) if options.truth else
                                      (0, {"collision_source": "none"}))
         books = {**truth_metrics, "speedup": speedup,
-                 "clock": "lockstep" if options.lockstep else "wall"}
+                 "clock": "lockstep" if options.lockstep else "wall",
+                 "live_checks": " | ".join(
+                     (f"vehicle {s}: " if len(crafts) > 1 else "")
+                     + c.station.live_check.summary()[1] for s, c in crafts.items())}
         if len(sysids) > 1:
             books["recordings"] = [r.path.as_posix() for s in sysids
                                    if (r := session.vehicles[s].recorder) is not None]

@@ -27,6 +27,7 @@ from collections.abc import Callable
 from firmware_link.records import (
     CommandAck,
     Heartbeat,
+    Imu,
     LinkEvent,
     LinkEventKind,
     StatusText,
@@ -44,6 +45,7 @@ from gcs.estimation import AltEstimator
 from gcs.station.execute import send_decision
 from gcs.station.exit import emergency_land, let_go
 from gcs.station.intents import STICK_MAX_US, STICK_MIN_US, StationIntents
+from gcs.station.live_check import LiveCheck
 from gcs.station.loop import FixedRateLoop
 from gcs.station.record import record_tick
 from gcs.station.snapshot import make_snapshot
@@ -61,13 +63,18 @@ from gcs.station.types import (
     control_mode,
 )
 from gcs.supervisor import (
+    AIRBORNE_CAPABLE,
     Intent,
     IntentKind,
     Outcome,
     Supervisor,
     SupervisorParams,
+    SupervisorState,
     VehicleStatus,
 )
+
+# armed and off the floor or leaving it: where vibration means something
+_FLYING = AIRBORNE_CAPABLE - {SupervisorState.ARMING, SupervisorState.SPOOL_UP}
 
 __all__ = [
     "STICK_MAX_US",
@@ -122,6 +129,7 @@ class Station(StationIntents):
         self._listeners: list[Callable[[StationSnapshot], None]] = []
         self._record_listeners: list[Callable[[TelemetryRecord], None]] = []
         self._listener_errors = 0
+        self.live_check = LiveCheck()  # logs check's cheap part, told to the pilot as it flies
         self._last_rx_s = -NEVER_S
         self._heartbeats_on = True
         self._empty_stats = self.loop.stats()
@@ -327,6 +335,9 @@ class Station(StationIntents):
         if self.recorder is not None:
             record_tick(self.recorder, inputs, out, self.loop.last_timing)
         snap = self._make_snapshot(t_s, k)
+        for text in self.live_check.tick(t_s, snap.armed and snap.state in _FLYING,
+                                         snap.link_stats, self.loop.last_timing):
+            self._event(t_s, EventLevel.WARNING, text)
         with self._lock:
             self._snapshot = snap
         for fn in self._listeners:
@@ -364,6 +375,8 @@ class Station(StationIntents):
                 topic = topics.topic_for(r)
                 if topic is not None:
                     rec.put(topic, r.t_s, r)
+            if isinstance(r, Imu):
+                self.live_check.imu(r)
             if isinstance(r, LinkEvent):
                 level = EventLevel.ERROR if r.kind is LinkEventKind.LOST else EventLevel.INFO
                 self._event(r.t_s, level, f"link {r.kind.value}: {r.detail}")

@@ -91,9 +91,21 @@ def fly_run(base: BaseFlight, run: RunSpec, output: Path, campaign: str) -> dict
             sim_s = session.clock.now_s()
         row = flown_row(run.run_id, values, summary)
         row["sim_s"] = sim_s
+        if base.record:
+            row.update(recording_checks(options.output))
     except Exception as exc:  # a failed run is a row with its reason, never the campaign's end
         row = failed_row(run.run_id, values, failure_text(exc))
     return stamped(row, c0, w0)
+
+
+def recording_checks(path: Path) -> dict[str, float]:
+    """A run's `logs check` metrics as its row's `check.<key>` columns: what `quadgcs logs check
+    --against` places a flight among."""
+    from gcs.flight_check import gather_file
+    from logs.check import measure
+    from logs.check.against import check_columns
+
+    return check_columns(measure(gather_file(path)))
 
 
 # errors whose text says what went wrong; any other gets its type's name in front

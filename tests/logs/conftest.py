@@ -9,6 +9,9 @@ import pytest
 
 from logs import Recorder
 from tests.fixture_paths import FLIGHT_TLOG
+from tests.logs.check_flights import clean_flight
+
+__all__ = ["clean_flight"]  # a session fixture: one recorded lockstep hold for `logs check`
 from tests.logs.flightgen import record, synthetic_flight
 
 ANCHOR_NS = 1_795_000_000_000_000_000
