@@ -12,8 +12,11 @@ from typing import Any
 
 import pytest
 
+from gcs.flight_check import gather_file
 from gcs.mission import recording as topics
 from logs import open_recording
+from logs.check import Status, evaluate, load_thresholds, measure
+from tests.logs.test_check_missions import ALWAYS
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -70,6 +73,18 @@ def _steps(d: dict[str, Any], topic: str) -> tuple[int, dict[str, set[str]]]:
     return n, shapes
 
 
+def _checked(out: Path, summary: dict[str, Any]) -> None:
+    """`logs check` on every vehicle's recording of the lockstep run: a clean mission fails no
+    check, and the checks every recording can answer are answered."""
+    assert "live checks PASS" in json.dumps(summary)  # the station's own summary line
+    recordings = sorted(out.glob("*.mcap"))
+    assert recordings
+    for path in recordings:
+        results = {r.key: r for r in evaluate(measure(gather_file(path)), load_thresholds(None))}
+        assert not [k for k, r in results.items() if r.status is Status.FAIL], path
+        assert all(results[k].status is not Status.SKIP for k in ALWAYS), path
+
+
 @pytest.mark.e2e
 @pytest.mark.timeout(400)
 @pytest.mark.parametrize(("name", "edits", "topic", "loop", "metrics"), [
@@ -93,6 +108,7 @@ def test_kinematic_and_lockstep_runs_of_one_mission_share_the_planner_loop(
     assert kin["planner_loop"] == sitl["planner_loop"] == loop
     assert metrics <= set(kin) and metrics <= set(sitl)
     assert kin["status"] == sitl["status"], (kin["reason"], sitl["reason"])
+    _checked(tmp_path / "lockstep", sitl)
     n_kin, kin_shape = _steps(kin, topic)
     n_sitl, sitl_shape = _steps(sitl, topic)
     # a record per planner step, the last one's too (the goal found, the budget spent)
