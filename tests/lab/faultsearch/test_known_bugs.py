@@ -19,7 +19,7 @@ BUDGET = 40  # runs per bug (sampler seed 1; bench/fault_search.py --known print
 PLAN = FlightPlan(alt_m=0.6, hold_s=1.0, step_m=0.2, step_observe_s=1.5)
 
 
-@pytest.mark.solo  # five short searches: 7-150 s each measured on the loaded 2-core machine
+# in-process lockstep searches (CPU-bound, not starved by a neighbour): no need to run alone
 @pytest.mark.parametrize("bug", BUGS, ids=[b.prop for b in BUGS])
 def test_the_search_finds_a_fixed_fault_put_back(bug: KnownBug) -> None:
     flight = SearchFlight(profile=bug.profile, plan=PLAN, fix_failsafe=bug.profile == "copter4")
