@@ -37,6 +37,7 @@ from gcs.preflight import PreflightReport, read_and_check
 from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlEndpoints, SitlOptions, SitlProcess
 from gcs.station.guardian import Guardian, GuardianSetup
+from gcs.station.rangefinder import vehicle_rangefinder
 from gcs.station.station import Station
 from gcs.station.types import clock_speedup
 from gcs.toml_file import read_signing_key
@@ -280,6 +281,9 @@ class StationSession:
             raise ParamError(f"{exc} (the throttle curve needs {', '.join(exc.names)})",
                              exc.names) from None
         curve = ThrottleCurve.for_dialect(link.dialect, params)
+        # the sonar's blind band and steps as the vehicle's driver has them (default 20 cm)
+        estimator, _ = vehicle_rangefinder(config.estimator, link.dialect, link.read_params)
+        config = dataclasses.replace(config, estimator=estimator)
         if mocap_url is not None:
             config = self._vehicle_sticks(link, config)
         mocap = None

@@ -7,6 +7,7 @@ position hold, the link-loss throttle, the repeated disarm of a kill) is here.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from firmware_link.records import FlightMode, RcCommand
@@ -14,6 +15,7 @@ from gcs.control.altitude_controller import AltControlOutput, AltitudeController
 from gcs.control.position_controller import PositionCommand, PositionController, PositionSetpoint
 from gcs.estimation import SonarStatus
 from gcs.supervisor.envelope import blind_sink_limit
+from gcs.supervisor.liftoff import LiftoffDetector
 from gcs.supervisor.outcomes import Outcome, OutcomeKind
 from gcs.supervisor.params import SupervisorParams
 from gcs.supervisor.types import (
@@ -42,12 +44,24 @@ class StateCommands:
     """The state the supervisor keeps and the commands its states send."""
 
     def __init__(self, params: SupervisorParams, alt_ctrl: AltitudeController,
-                 pos_ctrl: PositionController, *, rest_alt_m: float, ground_alt_m: float) -> None:
+                 pos_ctrl: PositionController, *, rest_alt_m: float, ground_alt_m: float,
+                 hold_floor_m: float = 0.0, takeoff_alt_m: float = 1.0,
+                 takeoff_climb_mps: float | None = None) -> None:
+        """`hold_floor_m`: the lowest altitude a hold is asked to keep (the sonar's blind band
+        plus a margin); `takeoff_alt_m`, `takeoff_climb_mps`: where a hold asked on the floor
+        with no altitude of its own climbs to, how fast (None: the controller's profile)."""
         self.p = params
         self.alt_ctrl = alt_ctrl
         self.pos_ctrl = pos_ctrl
         self.rest_alt_m = rest_alt_m
         self.ground_alt_m = ground_alt_m
+        self.hold_floor_m = hold_floor_m
+        self.takeoff_alt_m = max(takeoff_alt_m, hold_floor_m)
+        self.takeoff_climb_mps = takeoff_climb_mps
+        self._liftoff = LiftoffDetector()
+        self._lifted = False  # the take-off felt the vehicle leave the floor; PC control since
+        # (altitude m, velocity m/s) where it was felt to, for the estimator's next tick
+        self.liftoff_seed: tuple[float, float] | None = None
         self._blind = params.blind(alt_ctrl.params.gains.out_max)
         self.state = S.DISARMED
         self.since_s = 0.0
@@ -101,6 +115,9 @@ class StateCommands:
         if state is S.TAKEOFF:
             self._ramp_us = -1.0  # set from the hover stick on the first take-off tick
             self._ramp_top_since_s = None
+            self._liftoff.reset()
+        if state not in (S.HOLD, S.LINK_LOST, S.QUITTING):
+            self._lifted = False
 
     def _note(self, level: Level, text: str) -> None:
         self._notes.append(Note(level, text))
@@ -147,6 +164,20 @@ class StateCommands:
     def on_floor(self, alt_m: float) -> bool:
         """Whether an altitude estimate means standing on the floor."""
         return alt_m < self.ground_alt_m
+
+    @property
+    def flies_above_blind(self) -> bool:
+        """The PC holds a vehicle its take-off felt leave the floor, at or towards a height
+        above the sonar's blind band: a reading below the minimum range is the blind band then,
+        not the floor (the estimator's `airborne`). Not while it descends to land."""
+        if self.state is not S.HOLD or not self._lifted:
+            return False
+        goal = self.alt_target_m if self.alt_target_m is not None else self.alt_setpoint_m
+        return goal is not None and goal >= self.hold_floor_m
+
+    def hold_target_m(self, setpoint_m: float) -> float:
+        """A hold's altitude, raised to the blind band's top (plus its margin) when below."""
+        return max(setpoint_m, self.hold_floor_m)
 
     # ------------------------------------------------------------------ commands per state
     def _run(self, inp: TickIn) -> tuple[RcCommand | None, bool]:
@@ -236,8 +267,10 @@ class StateCommands:
         actually holds at, not an assumed one), so it neither climbs nor falls; minimum on the
         floor, where hover throttle would lift it (3.2.1's THR_MID is 1500 us); never above the
         pilot's own stick in MANUAL."""
-        if self.on_floor(alt_m):
+        if self.on_floor(alt_m) and not self._lifted:
             return STICK_MIN_US
+        # (a vehicle felt to lift is not on the floor, whatever an estimate still in the blind
+        # band says: minimum there drops it from up to the band's top, 2 m/s from 0.25 m)
         hover = self.alt_ctrl.flown_hover_stick_us()
         if self.state is S.MANUAL:
             return min(hover, self.sticks.throttle_us if self.gate_us is None else self.gate_us)
@@ -267,20 +300,41 @@ class StateCommands:
         hover = self.alt_ctrl.hover_stick_us()
         if self._ramp_us < 0.0:
             self._ramp_us = float(max(STICK_MIN_US, hover - p.ramp_below_hover_us))
-        if self._link is LinkHealth.DEGRADED:  # stale estimate: neither climb nor decide
-            return RcCommand(STICK_MID_US, STICK_MID_US, round(self._ramp_us), STICK_MID_US)
-        airborne = (est.alt_m > self.rest_alt_m + p.liftoff_rise_m
-                    and est.vel_mps > p.liftoff_vel_mps)
-        if airborne:
+        slow = self._ramp_us >= hover - p.ramp_slow_band_us
+        rate = p.ramp_slow_rate_us_per_s if slow else p.ramp_rate_us_per_s
+        if self._link is LinkHealth.DEGRADED:
+            # stale telemetry: neither climb nor decide, and no more than hover: a vehicle
+            # lifting unseen keeps its speed on it rather than gaining more
+            held = min(round(self._ramp_us), max(hover, STICK_MIN_US))
+            return RcCommand(STICK_MID_US, STICK_MID_US, held, STICK_MID_US)
+        expected = self.alt_ctrl.accel_for_throttle(self._ramp_us, inp.roll_rad, inp.pitch_rad)
+        felt = self._liftoff.update(est.acc_mps2, expected, inp.dt_s)
+        seen = (est.alt_m > self.rest_alt_m + p.liftoff_rise_m
+                and est.vel_mps > p.liftoff_vel_mps)
+        if felt or seen:
             # Off the floor, the hover throttle holds it (no more ground effect to overcome);
             # the ramp's own value, accelerating the vehicle, would carry into an overshoot.
-            back = p.ramp_rate_us_per_s * p.liftoff_lag_s
+            # What it added while the lift-off was being recognised comes off.
+            back = rate * p.liftoff_lag_s
+            how = "seen by the sonar"
+            self._lifted = True
+            if felt:
+                # the estimate stood on the floor (a blind sonar's zeros): it starts over
+                # from the accelerometer's height and speed, the hold from there too
+                lo = self._liftoff
+                how = f"felt at {lo.rise_m * 100:.0f} cm, {lo.vel_mps:.2f} m/s"
+                alt = self.rest_alt_m + lo.rise_m
+                self.liftoff_seed = (alt, lo.vel_mps)
+                inp = dataclasses.replace(inp, estimate=dataclasses.replace(
+                    est, alt_m=alt, vel_mps=lo.vel_mps, control_alt_m=alt,
+                    control_vel_mps=lo.vel_mps))
             self._engage(inp, max(STICK_MIN_US, min(hover, self._ramp_us - back)),
-                         f"left the floor at {round(self._ramp_us)} us: altitude hold on")
+                         f"left the floor at {round(self._ramp_us)} us ({how}): altitude "
+                         "hold on")
             self._went(OutcomeKind.LIFTED_OFF)
             return self._hold(inp)
         top = min(STICK_MAX_US, hover + p.ramp_above_hover_us)
-        self._ramp_us = min(top, self._ramp_us + p.ramp_rate_us_per_s * inp.dt_s)
+        self._ramp_us = min(top, self._ramp_us + rate * inp.dt_s)
         if self._ramp_us >= top:
             self._ramp_top_since_s = self._ramp_top_since_s or self._t
             if self._t - self._ramp_top_since_s > p.takeoff_give_up_s:
