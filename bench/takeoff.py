@@ -82,6 +82,7 @@ def main() -> int:
     ap.add_argument("--seeds", default="1-60", help="SITL seeds, FIRST-LAST (default 1-60)")
     ap.add_argument("--profiles", default="apm25,copter4", help="comma-separated profiles")
     ap.add_argument("--targets", default="1,2", help="comma-separated take-off altitudes (m)")
+    ap.add_argument("-v", "--verbose", action="store_true", help="one line per take-off too")
     args = ap.parse_args()
     seeds = seed_range(args.seeds)
     print(f"lockstep take-off, then a {HOLD_S:g} s hold, seeds {seeds[0]}-{seeds[-1]}, truth; "
@@ -92,7 +93,13 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for profile in args.profiles.split(","):
             for alt_m in (float(x) for x in args.targets.split(",")):
-                runs = [takeoff(profile, s, alt_m, Path(tmp)) for s in seeds]
+                runs = []
+                for seed in seeds:
+                    runs.append(takeoff(profile, seed, alt_m, Path(tmp)))
+                    if args.verbose:
+                        r = runs[-1]
+                        print(f"  seed {seed:3d}: overshoot {r.overshoot_pct:6.2f} %, hand-over "
+                              f"at {r.handover_m * 100:5.1f} cm, {r.handover_us} us", flush=True)
                 pct = np.array([r.overshoot_pct for r in runs])
                 hand = np.array([r.handover_m for r in runs]) * 100.0
                 worst = max(worst, float(pct.max()))

@@ -254,8 +254,8 @@ class AltEstimator(SonarReadings):
         each later reading.
 
         A tick can bring two readings (the sonar's rate beats against the loop's). When one of
-        them re-based the estimate on another surface, the tick's estimate says so, whatever
-        the later one did: the controller must move its setpoint by the jump, or it holds a
+        them re-based the estimate on another surface (or ended the blind band), the tick's
+        estimate says so, whatever the later one did: the controller must move its setpoint by the jump, or it holds a
         table's height as an error and dives for the surface it just left.
         """
         sonars = tick.sonars
@@ -266,11 +266,16 @@ class AltEstimator(SonarReadings):
                           tick.t_s, at_rest=tick.at_rest, baro_alt_m=tick.baro_alt_m,
                           airborne=tick.airborne)
         rebased = est.sonar_status is SonarStatus.REACQUIRED
+        unblinded = est.sonar_status is SonarStatus.UNBLINDED
         for extra in sonars[1:]:
             est = self.update(None, extra, None, tick.t_s, airborne=tick.airborne)
             rebased = rebased or est.sonar_status is SonarStatus.REACQUIRED
+            unblinded = unblinded or est.sonar_status is SonarStatus.UNBLINDED
         if rebased and est.sonar_status is not SonarStatus.REACQUIRED:
             est = replace(est, sonar_status=SonarStatus.REACQUIRED, sonar_used=True)
+        elif unblinded and est.sonar_status is not SonarStatus.UNBLINDED:
+            # the hold moves its climb by the correction (as by a re-base): it must hear of it
+            est = replace(est, sonar_status=SonarStatus.UNBLINDED, sonar_used=True)
         return est
 
     def _lifted_off(self, alt_m: float, vel_mps: float) -> None:

@@ -371,6 +371,12 @@ class StateCommands:
             self.alt_setpoint_m += jump
             if self.alt_target_m is not None:
                 self.alt_target_m += jump
+        elif est.sonar_status is SonarStatus.UNBLINDED and self._prev_alt_m is not None:
+            # The sonar's first word after the blind band corrected the accelerometer's coast
+            # through it: the climb goes on from where the vehicle is, at the profile's pace,
+            # to the same target, rather than surging to catch up a profile that ran ahead
+            # of it by the coast's drift (8-9 cm: lockstep copter4 seed 2 overshot 5 %).
+            self.alt_ctrl.surface_changed(est.alt_m - self._prev_alt_m)
         # the controller's profile makes the move: a ramp stopping dead would overshoot
         if self.alt_target_m is not None:
             self.alt_setpoint_m = self.alt_target_m

@@ -29,9 +29,9 @@ from dataclasses import dataclass
 class LiftoffParams:
     """When the accelerometer says the vehicle has left the floor (see the module)."""
 
-    accel_tc_s: float = 0.15
-    accel_mps2: float = 0.5
-    rise_mps: float = 0.2
+    accel_tc_s: float = 0.1
+    accel_mps2: float = 0.4
+    rise_mps: float = 0.12
     leak_s: float = 1.0
     min_expected_mps2: float = -2.5
 
@@ -47,13 +47,11 @@ class LiftoffDetector:
         self.params = params or LiftoffParams()
         self.acc_mps2 = 0.0  # averaged upward acceleration
         self.vel_mps = 0.0  # integrated since the ramp began, >= 0, leaking
-        self.rise_m = 0.0  # its integral since it was last 0: the height off the floor
 
     def reset(self) -> None:
         """A new ramp: standing on the floor."""
         self.acc_mps2 = 0.0
         self.vel_mps = 0.0
-        self.rise_m = 0.0
 
     def update(self, acc_up_mps2: float, expected_mps2: float, dt_s: float) -> bool:
         """One tick: the estimator's bias-corrected upward acceleration, the acceleration the
@@ -63,8 +61,13 @@ class LiftoffDetector:
         if dt_s <= 0.0:
             return False
         self.acc_mps2 += (acc_up_mps2 - self.acc_mps2) * dt_s / (p.accel_tc_s + dt_s)
-        v = self.vel_mps + (acc_up_mps2 - self.vel_mps / p.leak_s) * dt_s
-        self.rise_m = 0.0 if v <= 0.0 else self.rise_m + 0.5 * (self.vel_mps + v) * dt_s
-        self.vel_mps = max(0.0, v)
+        self.vel_mps = max(0.0, self.vel_mps + (acc_up_mps2 - self.vel_mps / p.leak_s) * dt_s)
         return (expected_mps2 > p.min_expected_mps2 and self.acc_mps2 > p.accel_mps2
                 and self.vel_mps > p.rise_mps)
+
+    @property
+    def rise_m(self) -> float:
+        """How high the vehicle is by now, had it accelerated evenly from rest at the averaged
+        acceleration to the integrated speed (integrating the speed again would add up the
+        floor's vibration over the whole ramp: 17 cm "risen" with the vehicle at 1 cm)."""
+        return self.vel_mps**2 / (2.0 * max(self.acc_mps2, self.params.accel_mps2))
