@@ -62,4 +62,5 @@ def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
         output=args.output, fix_failsafe=getattr(args, "fix_failsafe", False),
         foxglove=getattr(args, "foxglove", None),
         forward=tuple(getattr(args, "forward", None) or ()),
+        takeoff_alt_m=getattr(args, "takeoff_alt", None),
     )

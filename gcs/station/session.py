@@ -76,6 +76,8 @@ class SessionOptions:
     fix_failsafe: bool = False  # the pilot's consent to set unsafe failsafe parameters
     foxglove: str | None = None  # [HOST:]PORT: serve the flight live to Foxglove
     forward: tuple[str, ...] = ()  # other ground stations' URLs (firmware_link.forward)
+    # where a hold asked on the floor with no altitude climbs to (None: the config's, 1.0 m)
+    takeoff_alt_m: float | None = None
 
     def validate(self) -> None:
         """Reject impossible combinations with one line each."""
@@ -284,6 +286,9 @@ class StationSession:
         # the sonar's blind band and steps as the vehicle's driver has them (default 20 cm)
         estimator, _ = vehicle_rangefinder(config.estimator, link.dialect, link.read_params)
         config = dataclasses.replace(config, estimator=estimator)
+        if o.takeoff_alt_m is not None:
+            config = dataclasses.replace(config, flight=dataclasses.replace(
+                config.flight, takeoff_alt_m=o.takeoff_alt_m))
         if mocap_url is not None:
             config = self._vehicle_sticks(link, config)
         mocap = None
