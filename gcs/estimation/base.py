@@ -255,8 +255,8 @@ class AltEstimator(SonarReadings):
 
         A tick can bring two readings (the sonar's rate beats against the loop's). When one of
         them re-based the estimate on another surface (or ended the blind band), the tick's
-        estimate says so, whatever the later one did: the controller must move its setpoint by the jump, or it holds a
-        table's height as an error and dives for the surface it just left.
+        estimate says so, whatever the later one did: the controller must move its setpoint by
+        the jump, or it holds a table's height as an error and dives for the surface it left.
         """
         sonars = tick.sonars
         self._command_acc = tick.command_acc_mps2

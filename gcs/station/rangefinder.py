@@ -58,7 +58,10 @@ def vehicle_rangefinder(est: EstimatorParams, dialect: Dialect,
     if dialect is Dialect.APM25 and _one(read, "RNGFND_TYPE") == ANALOG_TYPE:
         scaling = _one(read, "RNGFND_SCALING")
         if scaling is not None and scaling > 0.0:
-            out = dataclasses.replace(out, **analog_steps(scaling))
+            steps = analog_steps(scaling)
+            out = dataclasses.replace(out, sonar_resolution_m=steps["sonar_resolution_m"],
+                                      sonar_bias_m=steps["sonar_bias_m"],
+                                      sonar_stale_move_m=steps["sonar_stale_move_m"])
             line += (f", analog steps {out.sonar_resolution_m * 100:.1f} cm, "
                      f"{out.sonar_bias_m * 100:.1f} cm short on average")
     return out, line
