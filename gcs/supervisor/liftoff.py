@@ -29,9 +29,9 @@ from dataclasses import dataclass
 class LiftoffParams:
     """When the accelerometer says the vehicle has left the floor (see the module)."""
 
-    accel_tc_s: float = 0.15
-    accel_mps2: float = 0.5
-    rise_mps: float = 0.15
+    accel_tc_s: float = 0.1
+    accel_mps2: float = 0.4
+    rise_mps: float = 0.12
     leak_s: float = 1.0
     min_expected_mps2: float = -2.5
 
