@@ -7,7 +7,6 @@ position hold, the link-loss throttle, the repeated disarm of a kill) is here.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 from firmware_link.records import FlightMode, RcCommand
@@ -18,8 +17,8 @@ from gcs.supervisor.envelope import blind_sink_limit
 from gcs.supervisor.liftoff import LiftoffDetector
 from gcs.supervisor.outcomes import Outcome, OutcomeKind
 from gcs.supervisor.params import SupervisorParams
+from gcs.supervisor.takeoff import TakeoffCommands
 from gcs.supervisor.types import (
-    STICK_MAX_US,
     STICK_MID_US,
     STICK_MIN_US,
     Action,
@@ -40,7 +39,7 @@ MANUAL_THROTTLE_MODES = frozenset({FlightMode.STABILIZE, FlightMode.ACRO})
 LEVEL = RcCommand(STICK_MID_US, STICK_MID_US, STICK_MIN_US, STICK_MID_US)
 
 
-class StateCommands:
+class StateCommands(TakeoffCommands):
     """The state the supervisor keeps and the commands its states send."""
 
     def __init__(self, params: SupervisorParams, alt_ctrl: AltitudeController,
@@ -165,20 +164,6 @@ class StateCommands:
         """Whether an altitude estimate means standing on the floor."""
         return alt_m < self.ground_alt_m
 
-    @property
-    def flies_above_blind(self) -> bool:
-        """The PC holds a vehicle its take-off felt leave the floor, at or towards a height
-        above the sonar's blind band: a reading below the minimum range is the blind band then,
-        not the floor (the estimator's `airborne`). Not while it descends to land."""
-        if self.state is not S.HOLD or not self._lifted:
-            return False
-        goal = self.alt_target_m if self.alt_target_m is not None else self.alt_setpoint_m
-        return goal is not None and goal >= self.hold_floor_m
-
-    def hold_target_m(self, setpoint_m: float) -> float:
-        """A hold's altitude, raised to the blind band's top (plus its margin) when below."""
-        return max(setpoint_m, self.hold_floor_m)
-
     # ------------------------------------------------------------------ commands per state
     def _run(self, inp: TickIn) -> tuple[RcCommand | None, bool]:
         st = self.state
@@ -294,56 +279,6 @@ class StateCommands:
         return s
 
     # ------------------------------------------------------------------ PC control
-    def _takeoff(self, inp: TickIn) -> RcCommand:
-        p = self.p
-        est = inp.estimate
-        hover = self.alt_ctrl.hover_stick_us()
-        if self._ramp_us < 0.0:
-            self._ramp_us = float(max(STICK_MIN_US, hover - p.ramp_below_hover_us))
-        slow = self._ramp_us >= hover - p.ramp_slow_band_us
-        rate = p.ramp_slow_rate_us_per_s if slow else p.ramp_rate_us_per_s
-        if self._link is LinkHealth.DEGRADED:
-            # stale telemetry: neither climb nor decide, and no more than hover: a vehicle
-            # lifting unseen keeps its speed on it rather than gaining more
-            held = min(round(self._ramp_us), max(hover, STICK_MIN_US))
-            return RcCommand(STICK_MID_US, STICK_MID_US, held, STICK_MID_US)
-        expected = self.alt_ctrl.accel_for_throttle(self._ramp_us, inp.roll_rad, inp.pitch_rad)
-        felt = self._liftoff.update(est.acc_mps2, expected, inp.dt_s)
-        seen = (est.alt_m > self.rest_alt_m + p.liftoff_rise_m
-                and est.vel_mps > p.liftoff_vel_mps)
-        if felt or seen:
-            # Off the floor, the hover throttle holds it (no more ground effect to overcome);
-            # the ramp's own value, accelerating the vehicle, would carry into an overshoot.
-            # What it added while the lift-off was being recognised comes off.
-            back = rate * p.liftoff_lag_s
-            how = "seen by the sonar"
-            self._lifted = True
-            if felt:
-                # the estimate stood on the floor (a blind sonar's zeros): it starts over
-                # from the accelerometer's height and speed, the hold from there too
-                lo = self._liftoff
-                how = f"felt at {lo.rise_m * 100:.0f} cm, {lo.vel_mps:.2f} m/s"
-                alt = self.rest_alt_m + lo.rise_m
-                self.liftoff_seed = (alt, lo.vel_mps)
-                inp = dataclasses.replace(inp, estimate=dataclasses.replace(
-                    est, alt_m=alt, vel_mps=lo.vel_mps, control_alt_m=alt,
-                    control_vel_mps=lo.vel_mps))
-            self._engage(inp, max(STICK_MIN_US, min(hover, self._ramp_us - back)),
-                         f"left the floor at {round(self._ramp_us)} us ({how}): altitude "
-                         "hold on")
-            self._went(OutcomeKind.LIFTED_OFF)
-            return self._hold(inp)
-        top = min(STICK_MAX_US, hover + p.ramp_above_hover_us)
-        self._ramp_us = min(top, self._ramp_us + rate * inp.dt_s)
-        if self._ramp_us >= top:
-            self._ramp_top_since_s = self._ramp_top_since_s or self._t
-            if self._t - self._ramp_top_since_s > p.takeoff_give_up_s:
-                self._to_manual(f"take-off: the vehicle did not leave the floor at "
-                                f"{top} us", STICK_MIN_US, Level.ERROR)
-                self._went(OutcomeKind.TAKEOFF_FAILED)
-                return LEVEL
-        return RcCommand(STICK_MID_US, STICK_MID_US, round(self._ramp_us), STICK_MID_US)
-
     def _engage(self, inp: TickIn, throttle_us: float, reason: str) -> None:
         self.alt_ctrl.engage(inp.estimate, throttle_us, inp.roll_rad, inp.pitch_rad)
         self.alt_setpoint_m = inp.estimate.alt_m
