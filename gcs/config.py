@@ -55,6 +55,9 @@ class FlightProfile:
     """How `fly` takes off, holds and lands."""
 
     takeoff_climb_mps: float = 0.5  # setpoint ramp while taking off
+    # where a hold asked on the floor with no altitude of its own (the TUI's `h`) climbs to;
+    # never below the sonar's blind band plus a margin (the supervisor raises it there)
+    takeoff_alt_m: float = 1.0
     land_descent_mps: float = 0.3
     land_handover_alt_m: float = 0.15  # below this, LAND mode / throttle down finishes the job
     settle_s: float = 4.0  # after reaching the hold altitude, before the hold is scored

@@ -83,4 +83,5 @@ def session_options(args: argparse.Namespace, command: str) -> SessionOptions:
         foxglove=getattr(args, "foxglove", None),
         forward=tuple(getattr(args, "forward", None) or ()),
         connect_timeout_s=connect_timeout(args),
+        takeoff_alt_m=getattr(args, "takeoff_alt", None),
     )

@@ -21,12 +21,16 @@ if TYPE_CHECKING:
 
 MAX_GAMEPAD_RATE_HZ = 250.0
 
+MAX_TAKEOFF_ALT_M = 3.5
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the `teleop` subcommand."""
     p = sub.add_parser("teleop", help="fly one vehicle from the terminal (TUI)",
                        description=__doc__)
     add_vehicle_arguments(p)
+    p.add_argument("--takeoff-alt", type=float, metavar="M",
+                   help="where `h` from the floor climbs to (default 1.0 m; never below the "
+                        "rangefinder's minimum range plus a margin, read from the vehicle)")
     p.add_argument("--gamepad", nargs="?", const="", default=None, metavar="NAME|INDEX",
                    help="fly with a gamepad (SDL2): the first pad, the one at INDEX, or the "
                         "first whose name contains NAME; it takes the sticks from the keyboard")
@@ -40,6 +44,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def options_from_args(args: argparse.Namespace) -> SessionOptions:
     """The session the flags ask for."""
+    alt = getattr(args, "takeoff_alt", None)
+    if alt is not None and not 0.0 < alt <= MAX_TAKEOFF_ALT_M:
+        raise UsageError(f"--takeoff-alt {alt:g}: expected 0 < M <= {MAX_TAKEOFF_ALT_M:g} "
+                         "(the sonar's trustworthy range)")
     return session_options(args, "teleop")
 
 

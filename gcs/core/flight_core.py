@@ -48,9 +48,13 @@ class FlightCore:
             dialect = Dialect.COPTER4 if curve.kind is CurveKind.COPTER4 else Dialect.APM25
             climb = ClimbRateHold(config.climb,
                                   climb_stick or ClimbStickMap.for_dialect(dialect))
-        self.supervisor = Supervisor(supervisor, self.alt_ctrl, self.pos_ctrl,
-                                     rest_alt_m=est.rest_alt_m, ground_alt_m=est.ground_alt_m,
-                                     climb=climb)
+        # the sonar reads from sonar_min_m below it, so the estimate has it from here up
+        blind_top_m = est.sonar_min_m + est.sonar_offset_m
+        self.supervisor = Supervisor(
+            supervisor, self.alt_ctrl, self.pos_ctrl, rest_alt_m=est.rest_alt_m,
+            ground_alt_m=est.ground_alt_m, hold_floor_m=blind_top_m + supervisor.blind_margin_m,
+            takeoff_alt_m=config.flight.takeoff_alt_m,
+            takeoff_climb_mps=config.flight.takeoff_climb_mps, climb=climb)
         self.link_down = LinkDownClock()
         self.last: TickOutputs | None = None
         # the newest attitude and pose of any tick: the supervisor flies on them until others come
@@ -88,7 +92,9 @@ class FlightCore:
             list(inputs.imus), inputs.sonars,
             inputs.attitudes[-1] if inputs.attitudes else None, inputs.t_s, at_rest=rest,
             baro_alt_m=baro_altitude_m(inputs.baros[-1].pressure_pa) if inputs.baros else None,
-            command_acc_mps2=last.supervisor.command_acc_mps2 if last is not None else None)
+            command_acc_mps2=last.supervisor.command_acc_mps2 if last is not None else None,
+            airborne=self.supervisor.flies_above_blind, liftoff=self.supervisor.liftoff_seed)
+        self.supervisor.liftoff_seed = None
         att = self._attitude
         out = self.supervisor.step(TickIn(
             t_s=inputs.t_s, dt_s=inputs.dt_s, intents=inputs.intents, vehicle=inputs.vehicle,

@@ -22,6 +22,9 @@ from gcs.estimation.params import EstimatorParams
 from gcs.estimation.repeat_motion import RepeatMotion
 from gcs.estimation.sonar_readings import SonarReadings
 
+LIFTOFF_ALT_SIGMA_M = 0.03
+LIFTOFF_VEL_SIGMA_MPS = 0.1
+
 
 class AltEstimator(SonarReadings):
     """Common driver: time step, attitude, accelerometer and sonar conditioning, gating.
@@ -66,6 +69,8 @@ class AltEstimator(SonarReadings):
         self._twin = control_start(0.0, 0.0, 0.1**2)
         self._command_acc: float | None = None
         self._command_lagged = self._command_residual = 0.0
+        self._airborne = False  # the station knows the vehicle is off the floor (update)
+        self._blind = False  # a reading below the minimum range came since the last in range
 
     @abstractmethod
     def _predict(self, acc_up_mps2: float, dt_s: float) -> None: ...
@@ -78,14 +83,21 @@ class AltEstimator(SonarReadings):
         t_s: float,
         at_rest: bool = False,
         baro_alt_m: float | None = None,
+        airborne: bool = False,
     ) -> AltEstimate:
         """Advance to `t_s` with the newest samples (None = nothing new since the last step).
 
         `at_rest`: the vehicle is known to stand still (disarmed). With the sonar reading the
         floor, the filter then knows the vertical velocity is 0, which pins the accelerometer
         bias before take-off instead of leaving it to the sonar in flight.
-        `baro_alt_m`: a new barometric altitude (any reference), for filters that fuse it."""
+        `baro_alt_m`: a new barometric altitude (any reference), for filters that fuse it.
+        `airborne`: the station knows the vehicle is off the floor (its take-off saw it lift
+        and it holds it above the sonar's blind band): a reading below the minimum range is
+        then the blind band (`SonarStatus.BLIND`), never the floor."""
         p = self.params
+        self._airborne = airborne
+        if not airborne:
+            self._blind = False
         if attitude is not None:
             self._roll, self._pitch = attitude.roll_rad, attitude.pitch_rad
         if imu is not None:
@@ -147,7 +159,8 @@ class AltEstimator(SonarReadings):
         # few ticks and a stall none for the whole gap.
         lost = (self._sonar_heard_s <= self._last_sonar_t_s
                 and t_s - self._imu_t_s < 0.5 * p.stale_after_s)
-        if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED) or at_rest
+        if (status in (SonarStatus.GROUND, SonarStatus.REACQUIRED, SonarStatus.UNBLINDED)
+                or at_rest
                 or age > (p.control_coast_s if lost else p.stale_after_s)
                 or not self._initialised):
             control_follow(ctl, alt, vel, sigma)
@@ -163,7 +176,8 @@ class AltEstimator(SonarReadings):
             vel_mps=vel,
             acc_mps2=self._acc_up - bias,
             bias_mps2=bias,
-            sonar_used=status in (SonarStatus.USED, SonarStatus.GROUND, SonarStatus.REACQUIRED),
+            sonar_used=status in (SonarStatus.USED, SonarStatus.GROUND, SonarStatus.REACQUIRED,
+                                  SonarStatus.UNBLINDED),
             sonar_status=status,
             innovation_m=innovation,
             sonar_age_s=age,
@@ -195,14 +209,19 @@ class AltEstimator(SonarReadings):
         at_rest: bool = False,
         baro_alt_m: float | None = None,
         command_acc_mps2: float | None = None,
+        airborne: bool = False,
+        liftoff: tuple[float, float] | None = None,
     ) -> AltEstimate:
         """One control tick with every sample it brought (see `catch_up` for late bursts).
 
         `command_acc_mps2`: the vertical acceleration the last stick command sent asks of the
-        vehicle (None when the station does not fly the throttle)."""
+        vehicle (None when the station does not fly the throttle). `airborne`: see `update`.
+        `liftoff`: the station's take-off felt the vehicle leave the floor at the last tick,
+        at this (altitude m, velocity m/s) by its accelerometer: the estimate, held on the
+        floor by the zeros of a sonar that is blind there, starts over from it."""
         samples = () if imus is None else (imus,) if isinstance(imus, Imu) else tuple(imus)
         inputs = EstimatorTick(t_s, samples, tuple(sonars), attitude, at_rest, baro_alt_m,
-                            command_acc_mps2)
+                               command_acc_mps2, airborne, liftoff)
         est = self._catch_up.tick(self, inputs, self._run_tick)
         assert isinstance(est, AltEstimate)
         return est
@@ -235,21 +254,39 @@ class AltEstimator(SonarReadings):
         each later reading.
 
         A tick can bring two readings (the sonar's rate beats against the loop's). When one of
-        them re-based the estimate on another surface, the tick's estimate says so, whatever
-        the later one did: the controller must move its setpoint by the jump, or it holds a
-        table's height as an error and dives for the surface it just left.
+        them re-based the estimate on another surface (or ended the blind band), the tick's
+        estimate says so, whatever the later one did: the controller must move its setpoint by
+        the jump, or it holds a table's height as an error and dives for the surface it left.
         """
         sonars = tick.sonars
         self._command_acc = tick.command_acc_mps2
+        if tick.liftoff is not None:
+            self._lifted_off(*tick.liftoff)
         est = self.update(average_imu(tick.imus), sonars[0] if sonars else None, tick.attitude,
-                          tick.t_s, at_rest=tick.at_rest, baro_alt_m=tick.baro_alt_m)
+                          tick.t_s, at_rest=tick.at_rest, baro_alt_m=tick.baro_alt_m,
+                          airborne=tick.airborne)
         rebased = est.sonar_status is SonarStatus.REACQUIRED
+        unblinded = est.sonar_status is SonarStatus.UNBLINDED
         for extra in sonars[1:]:
-            est = self.update(None, extra, None, tick.t_s)
+            est = self.update(None, extra, None, tick.t_s, airborne=tick.airborne)
             rebased = rebased or est.sonar_status is SonarStatus.REACQUIRED
+            unblinded = unblinded or est.sonar_status is SonarStatus.UNBLINDED
         if rebased and est.sonar_status is not SonarStatus.REACQUIRED:
             est = replace(est, sonar_status=SonarStatus.REACQUIRED, sonar_used=True)
+        elif unblinded and est.sonar_status is not SonarStatus.UNBLINDED:
+            # the hold moves its climb by the correction (as by a re-base): it must hear of it
+            est = replace(est, sonar_status=SonarStatus.UNBLINDED, sonar_used=True)
         return est
+
+    def _lifted_off(self, alt_m: float, vel_mps: float) -> None:
+        """The vertical state starts over where the take-off felt the vehicle leave the floor
+        (a few cm, known to a few cm; its velocity to 0.1 m/s: the accelerometer's integral)."""
+        p = self.params
+        self._seed(alt_m, vel_mps, LIFTOFF_ALT_SIGMA_M, LIFTOFF_VEL_SIGMA_MPS)
+        self._climb_vel_mps = max(self._climb_vel_mps, vel_mps, p.climb_vel_mps)
+        sigma = self._state()[3]
+        control_follow(self._control, alt_m, vel_mps, sigma)
+        control_follow(self._twin, alt_m, vel_mps, sigma)
 
     @abstractmethod
     def _baro(self, baro_alt_m: float, coasting: bool) -> None:

@@ -61,6 +61,10 @@ class EstimatorTick:
     baro_alt_m: float | None
     # the vertical acceleration the station's last stick command asked for (None: not known)
     command_acc_mps2: float | None = None
+    # the station knows the vehicle is off the floor (see AltEstimator.update)
+    airborne: bool = False
+    # the take-off felt the vehicle leave the floor last tick: (altitude m, velocity m/s) then
+    liftoff: tuple[float, float] | None = None
 
 
 class Restorable(Protocol):

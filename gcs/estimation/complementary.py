@@ -55,6 +55,11 @@ class ComplementaryEstimator(AltEstimator):
         self._pos_base, self._pos_corr, self._v = alt_m, 0.0, 0.0
         self._err = 0.0
 
+    def _seed(self, alt_m: float, vel_mps: float, alt_sigma_m: float,
+              vel_sigma_mps: float) -> None:
+        self._pos_base, self._pos_corr, self._v = alt_m, 0.0, vel_mps
+        self._err = 0.0
+
     def _baro(self, baro_alt_m: float, coasting: bool) -> None:
         return None  # sonar and accelerometer only, as the filter this one stands for
 

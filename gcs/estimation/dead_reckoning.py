@@ -42,6 +42,10 @@ class DeadReckoningEstimator(AltEstimator):
     def _reset_alt(self, alt_m: float) -> None:
         self._h, self._v, self._prev_z = alt_m, 0.0, None
 
+    def _seed(self, alt_m: float, vel_mps: float, alt_sigma_m: float,
+              vel_sigma_mps: float) -> None:
+        self._h, self._v, self._prev_z = alt_m, vel_mps, None
+
     def _baro(self, baro_alt_m: float, coasting: bool) -> None:
         return None  # sonar and accelerometer only, as the filter this one stands for
 

@@ -13,11 +13,17 @@ class SonarStatus(enum.Enum):
     USED = "used"
     GROUND = "ground"  # zero reading near the floor, used as altitude 0
     INVALID = "invalid"  # out of range / zero in the air
+    # below the sensor's minimum range with the vehicle known to be off the floor (its take-off
+    # saw it lift): the sensor is blind there; the estimate coasts on the accelerometer
+    BLIND = "blind"
     DUPLICATE = "duplicate"  # the stream repeating a reading the sensor has not replaced
     REJECTED = "rejected"  # failed the innovation gate (outlier, late echo)
     # consistent readings after rejections (estimate reset to them), or one reading that moved
     # the estimate by a surface step (accepted through a gate widened by a long coast)
     REACQUIRED = "reacquired"
+    # the first in-range reading after the blind band, taken through a gate as wide as the
+    # band (the coast through it drifted): a correction, not another surface
+    UNBLINDED = "unblinded"
 
 
 @dataclass(frozen=True, slots=True)

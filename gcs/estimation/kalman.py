@@ -159,6 +159,20 @@ class KalmanEstimator(AltEstimator):
             P[_CLONE][j] = P[j][_CLONE] = P[_ALT][j]
         P[_CLONE][_CLONE] = P[_ALT][_ALT]
 
+    def _widen_alt(self, var_m2: float) -> None:
+        self._P[0][0] += var_m2
+
+    def _seed(self, alt_m: float, vel_mps: float, alt_sigma_m: float,
+              vel_sigma_mps: float) -> None:
+        self._x[_BARO] -= alt_m - self._x[0]
+        self._x[0], self._x[1] = alt_m, vel_mps
+        P = self._P
+        for j in range(_N):
+            P[0][j] = P[j][0] = P[1][j] = P[j][1] = 0.0
+        P[0][0] = alt_sigma_m**2
+        P[1][1] = vel_sigma_mps**2
+        self._clone()
+
     def _reset_alt(self, alt_m: float) -> None:
         # a reset follows a long disagreement, so the velocity is not trusted either; the
         # barometer has not moved, so its offset takes up the jump

@@ -9,6 +9,9 @@ from dataclasses import dataclass
 class EstimatorParams:
     """Estimator tuning; sonar limits are the HC-SR04's (thesis sec. 5.2)."""
 
+    # The driver's minimum range (RNGFND1_MIN, RNGFND_MIN_CM: 0.2 m on both firmwares; the
+    # HC-SR04's own 2 cm by default). Below it the sensor is blind: a reading there is the
+    # floor only while the vehicle stands on it; in the air it says nothing (see `airborne`).
     sonar_min_m: float = 0.02
     sonar_max_m: float = 4.0
     sonar_sigma_m: float = 0.01  # the HC-SR04's σ; tilt is corrected, late echoes re-timed
@@ -16,6 +19,11 @@ class EstimatorParams:
     # integer cm / 100, 4.x's DISTANCE_SENSOR a uint16 of cm): rounding adds a uniform error of
     # ±resolution/2, σ = resolution/√12 ≈ 0.29 cm, to the sensor's own noise. 0 for a float range.
     sonar_resolution_m: float = 0.01
+    # What the driver's readings lack on average (its truncations): 3.2.1's analog sonar floors
+    # the ADC's code, the millivolts and the centimetres, and reads 4.0 cm short on average
+    # (steps of 5.9 cm: half a step, plus half a mV times RNGFND_SCALING, plus half a cm); the
+    # real 3.2.1 read about 5 cm low at 1 m. Added to every reading. 0 for a rounding driver.
+    sonar_bias_m: float = 0.0
     # The HC-SR04 pings at most every 50 ms (20 Hz). The telemetry stream repeats its latest
     # reading at the stream's rate (40 Hz here), and neither message says when the reading was
     # taken (DISTANCE_SENSOR's time_boot_ms is the send time), so the same value arriving sooner
@@ -128,7 +136,7 @@ class EstimatorParams:
         for name in positive:
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"{name} must be > 0")
-        for name in ("command_blend_tc_s", "command_lag_s", "sonar_resolution_m",
+        for name in ("command_blend_tc_s", "command_lag_s", "sonar_resolution_m", "sonar_bias_m",
                      "sonar_repeat_s", "sonar_stale_move_m", "sonar_stale_drift_mps",
                      "sonar_doubt_s", "control_coast_s"):
             if getattr(self, name) < 0.0:

@@ -41,6 +41,8 @@ class SonarReadings(ABC):
     _reject_run_start_s: float
     _reject_seen_s: float
     _twin: ControlState
+    _airborne: bool
+    _blind: bool
 
     @abstractmethod
     def _gate(self, z_alt_m: float, extra_var_m2: float = 0.0) -> bool:
@@ -51,6 +53,14 @@ class SonarReadings(ABC):
 
     @abstractmethod
     def _reset_alt(self, alt_m: float) -> None: ...
+
+    @abstractmethod
+    def _seed(self, alt_m: float, vel_mps: float, alt_sigma_m: float,
+              vel_sigma_mps: float) -> None:
+        """Start the vertical state over at this altitude and velocity (and their sigmas)."""
+
+    def _widen_alt(self, var_m2: float) -> None:  # noqa: B027 - filters without a variance
+        """Add `var_m2` to the altitude's variance (a coast known to have drifted that much)."""
 
     @abstractmethod
     def _state(self) -> tuple[float, float, float, float]:
@@ -156,6 +166,12 @@ class SonarReadings(ABC):
         p = self.params
         self._reading_late = False
         in_range = sonar.valid and p.sonar_min_m <= d <= p.sonar_max_m
+        if not in_range and self._airborne and d < p.sonar_min_m:
+            # Off the floor (the station saw it lift) and under the minimum range: the sensor
+            # is blind, not on the floor. Pinning the estimate to the floor here held it there
+            # while the take-off ramp ran on (real 4.7: seen 1.15 s late, 0.3 m up, 1.3 m/s).
+            self._blind = True
+            return SonarStatus.BLIND, 0.0
         if not in_range:
             if (d <= p.sonar_min_m and alt_pred < p.ground_alt_m
                     and self._climb_vel_mps < p.climb_vel_mps):
@@ -174,7 +190,9 @@ class SonarReadings(ABC):
                 # whole centimetres a steady floor past a table's edge mostly repeats)
                 self._reject_seen_s = t_s
             return SonarStatus.DUPLICATE, 0.0
-        z = sonar_altitude_m(d + p.sonar_offset_m, self._roll, self._pitch)
+        z = sonar_altitude_m(d + p.sonar_offset_m + p.sonar_bias_m, self._roll, self._pitch)
+        if self._blind:
+            return self._unblinded(z, t_s, alt_pred)
         # The HC-SR04 does not ping again before an echo is back, so a reading after a long
         # silence is a late echo of a ping sent about when the previous reading arrived
         # (`ping_t_s`; carpet, thesis ch. 7): it measures the altitude of then, not of now.
@@ -216,6 +234,33 @@ class SonarReadings(ABC):
         self._rejected.clear()
         self._last_sonar_t_s = t_s
         return SonarStatus.REACQUIRED, believed - alt_pred
+
+    def _unblinded(self, z: float, t_s: float, alt_pred: float) -> tuple[SonarStatus, float]:
+        """The first in-range reading after the blind band. The estimate crossed the band on
+        the accelerometer alone, so a gate as narrow as a steady hover's would refuse the
+        sonar's first word on where the vehicle is (real 4.7: the first readings failed it and
+        the estimate lagged truth by 24-32 cm); it is taken through a gate as wide as the band
+        (a carpet's far echo still fails that), and, with its altitude variance widened by the
+        disagreement, moves the estimate onto it. Its timing is not a late echo's: the band's
+        zeros repeat, and their first arrival is not this reading's ping."""
+        p = self.params
+        self._reading_late = False
+        innovation = z - alt_pred
+        if not self._initialised:
+            self._initialised = True
+            self._blind = False
+            self._reset_alt(z)
+            self._last_sonar_t_s = t_s
+            return SonarStatus.UNBLINDED, innovation
+        if not self._gate(z, p.sonar_min_m**2):
+            self._rejected_total += 1
+            return SonarStatus.REJECTED, innovation
+        self._blind = False
+        self._rejected.clear()
+        self._widen_alt(innovation * innovation)
+        self._correct(z, t_s)
+        self._last_sonar_t_s = t_s
+        return SonarStatus.UNBLINDED, innovation
 
     def _reacquired_at(self, t_s: float, z_now: float) -> float | None:
         """The altitude to reset to when the sonar has disagreed for longer than any late echo

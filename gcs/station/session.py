@@ -40,6 +40,7 @@ from gcs.preflight import PreflightReport, read_and_check
 from gcs.scoring import Series, station_time
 from gcs.sitl_process import SitlEndpoints, SitlOptions, SitlProcess
 from gcs.station.guardian import Guardian, GuardianSetup
+from gcs.station.rangefinder import vehicle_rangefinder
 from gcs.station.station import Station
 from gcs.station.types import clock_speedup
 from gcs.toml_file import read_signing_key
@@ -80,6 +81,8 @@ class SessionOptions:
     forward: tuple[str, ...] = ()  # other ground stations' URLs (firmware_link.forward)
     # how long `connect` is waited for when it is not up yet (firmware_link.wait_up)
     connect_timeout_s: float = DEFAULT_CONNECT_TIMEOUT_S
+    # where a hold asked on the floor with no altitude climbs to (None: the config's, 1.0 m)
+    takeoff_alt_m: float | None = None
 
     def validate(self) -> None:
         """Reject impossible combinations with one line each."""
@@ -298,6 +301,12 @@ class StationSession:
                              f"{', '.join(exc.names)})",
                              exc.names) from None
         curve = ThrottleCurve.for_dialect(link.dialect, params)
+        # the sonar's blind band and steps as the vehicle's driver has them (default 20 cm)
+        estimator, _ = vehicle_rangefinder(config.estimator, link.dialect, link.read_params)
+        config = dataclasses.replace(config, estimator=estimator)
+        if o.takeoff_alt_m is not None:
+            config = dataclasses.replace(config, flight=dataclasses.replace(
+                config.flight, takeoff_alt_m=o.takeoff_alt_m))
         climb_stick = ClimbStickMap.for_dialect(link.dialect, params) if climbing else None
         if mocap_url is not None:
             config = self._vehicle_sticks(link, config)

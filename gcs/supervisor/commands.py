@@ -16,10 +16,11 @@ from gcs.control.position_controller import PositionCommand, PositionController,
 from gcs.estimation import SonarStatus
 from gcs.supervisor.climb_mode import ClimbModeCommands, pc_mode
 from gcs.supervisor.envelope import blind_sink_limit
+from gcs.supervisor.liftoff import LiftoffDetector
 from gcs.supervisor.outcomes import Outcome, OutcomeKind
 from gcs.supervisor.params import SupervisorParams
+from gcs.supervisor.takeoff import TakeoffCommands
 from gcs.supervisor.types import (
-    STICK_MAX_US,
     STICK_MID_US,
     STICK_MIN_US,
     Action,
@@ -40,12 +41,18 @@ MANUAL_THROTTLE_MODES = frozenset({FlightMode.STABILIZE, FlightMode.ACRO})
 LEVEL = RcCommand(STICK_MID_US, STICK_MID_US, STICK_MIN_US, STICK_MID_US)
 
 
-class StateCommands(ClimbModeCommands):
+class StateCommands(ClimbModeCommands, TakeoffCommands):
     """The state the supervisor keeps and the commands its states send."""
 
     def __init__(self, params: SupervisorParams, alt_ctrl: AltitudeController,
                  pos_ctrl: PositionController, *, rest_alt_m: float, ground_alt_m: float,
+                 hold_floor_m: float = 0.0, takeoff_alt_m: float = 1.0,
+                 takeoff_climb_mps: float | None = None,
                  climb: ClimbRateHold | None = None) -> None:
+        """`hold_floor_m`: the lowest altitude a hold is asked to keep (the sonar's blind band
+        plus a margin); `takeoff_alt_m`, `takeoff_climb_mps`: where a hold asked on the floor
+        with no altitude of its own climbs to, how fast (None: the controller's profile);
+        `climb`: the climb-rate hold, flown in ALT_HOLD (None: the direct-throttle hold)."""
         self.p = params
         self.alt_ctrl = alt_ctrl
         # the climb-rate hold, flown in ALT_HOLD (climb_mode); None: the direct-throttle hold
@@ -57,6 +64,13 @@ class StateCommands(ClimbModeCommands):
         self.pos_ctrl = pos_ctrl
         self.rest_alt_m = rest_alt_m
         self.ground_alt_m = ground_alt_m
+        self.hold_floor_m = hold_floor_m
+        self.takeoff_alt_m = max(takeoff_alt_m, hold_floor_m)
+        self.takeoff_climb_mps = takeoff_climb_mps
+        self._liftoff = LiftoffDetector()
+        self._lifted = False  # the take-off felt the vehicle leave the floor; PC control since
+        # (altitude m, velocity m/s) where it was felt to, for the estimator's next tick
+        self.liftoff_seed: tuple[float, float] | None = None
         self._blind = params.blind(alt_ctrl.params.gains.out_max)
         self.state = S.DISARMED
         self.since_s = 0.0
@@ -110,6 +124,9 @@ class StateCommands(ClimbModeCommands):
         if state is S.TAKEOFF:
             self._ramp_us = -1.0  # set from the hover stick on the first take-off tick
             self._ramp_top_since_s = None
+            self._liftoff.reset()
+        if state not in (S.HOLD, S.LINK_LOST, S.QUITTING):
+            self._lifted = False
 
     def _note(self, level: Level, text: str) -> None:
         self._notes.append(Note(level, text))
@@ -253,8 +270,10 @@ class StateCommands(ClimbModeCommands):
         actually holds at, not an assumed one), so it neither climbs nor falls; minimum on the
         floor, where hover throttle would lift it (3.2.1's THR_MID is 1500 us); never above the
         pilot's own stick in MANUAL."""
-        if self.on_floor(alt_m):
+        if self.on_floor(alt_m) and not self._lifted:
             return STICK_MIN_US
+        # (a vehicle felt to lift is not on the floor, whatever an estimate still in the blind
+        # band says: minimum there drops it from up to the band's top, 2 m/s from 0.25 m)
         if self.climb is not None and self._vehicle_mode == FlightMode.ALT_HOLD:
             return STICK_MID_US  # ALT_HOLD's dead zone: the firmware holds its height
         hover = self.alt_ctrl.flown_hover_stick_us()
@@ -280,35 +299,6 @@ class StateCommands(ClimbModeCommands):
         return s
 
     # ------------------------------------------------------------------ PC control
-    def _takeoff(self, inp: TickIn) -> RcCommand:
-        p = self.p
-        est = inp.estimate
-        hover = self.alt_ctrl.hover_stick_us()
-        if self._ramp_us < 0.0:
-            self._ramp_us = float(max(STICK_MIN_US, hover - p.ramp_below_hover_us))
-        if self._link is LinkHealth.DEGRADED:  # stale estimate: neither climb nor decide
-            return RcCommand(STICK_MID_US, STICK_MID_US, round(self._ramp_us), STICK_MID_US)
-        airborne = (est.alt_m > self.rest_alt_m + p.liftoff_rise_m
-                    and est.vel_mps > p.liftoff_vel_mps)
-        if airborne:
-            # Off the floor, the hover throttle holds it (no more ground effect to overcome);
-            # the ramp's own value, accelerating the vehicle, would carry into an overshoot.
-            back = p.ramp_rate_us_per_s * p.liftoff_lag_s
-            self._engage(inp, max(STICK_MIN_US, min(hover, self._ramp_us - back)),
-                         f"left the floor at {round(self._ramp_us)} us: altitude hold on")
-            self._went(OutcomeKind.LIFTED_OFF)
-            return self._hold(inp)
-        top = min(STICK_MAX_US, hover + p.ramp_above_hover_us)
-        self._ramp_us = min(top, self._ramp_us + p.ramp_rate_us_per_s * inp.dt_s)
-        if self._ramp_us >= top:
-            self._ramp_top_since_s = self._ramp_top_since_s or self._t
-            if self._t - self._ramp_top_since_s > p.takeoff_give_up_s:
-                self._to_manual(f"take-off: the vehicle did not leave the floor at "
-                                f"{top} us", STICK_MIN_US, Level.ERROR)
-                self._went(OutcomeKind.TAKEOFF_FAILED)
-                return LEVEL
-        return RcCommand(STICK_MID_US, STICK_MID_US, round(self._ramp_us), STICK_MID_US)
-
     def _engage(self, inp: TickIn, throttle_us: float, reason: str) -> None:
         self.alt_ctrl.engage(inp.estimate, throttle_us, inp.roll_rad, inp.pitch_rad)
         if self.climb is not None:
@@ -338,6 +328,12 @@ class StateCommands(ClimbModeCommands):
             self.alt_setpoint_m += jump
             if self.alt_target_m is not None:
                 self.alt_target_m += jump
+        elif est.sonar_status is SonarStatus.UNBLINDED and self._prev_alt_m is not None:
+            # The sonar's first word after the blind band corrected the accelerometer's coast
+            # through it: the climb goes on from where the vehicle is, at the profile's pace,
+            # to the same target, rather than surging to catch up a profile that ran ahead
+            # of it by the coast's drift (8-9 cm: lockstep copter4 seed 2 overshot 5 %).
+            self.alt_ctrl.surface_changed(est.alt_m - self._prev_alt_m)
         # the controller's profile makes the move: a ramp stopping dead would overshoot
         if self.alt_target_m is not None:
             self.alt_setpoint_m = self.alt_target_m

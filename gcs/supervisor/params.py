@@ -65,11 +65,22 @@ class SupervisorParams:
     stabilize_to_disarm: bool = True
     ramp_below_hover_us: int = 150  # the take-off ramp starts this far below the hover stick
     ramp_rate_us_per_s: float = 100.0
-    ramp_above_hover_us: int = 250  # and gives up this far above it
+    # ...and from this far below it on, where the vehicle may leave the floor, climbs slower:
+    # what the ramp adds while lift-off is being recognised is what the vehicle climbs on
+    ramp_slow_band_us: int = 50
+    ramp_slow_rate_us_per_s: float = 40.0
+    # ...and gives up this far above it. Not more: a ramp's last override is what the vehicle
+    # flies blind when the uplink dies (until its failsafe acts, 2-5 s), and 250 us over hover
+    # is a climb of ~5 m/s after 1 s (ECOSYSTEM: +100 us, +2.2 m/s after 1 s)
+    ramp_above_hover_us: int = 100
     takeoff_give_up_s: float = 3.0  # at the top of the ramp without leaving the floor
     liftoff_rise_m: float = 0.04  # above the rest height ...
     liftoff_vel_mps: float = 0.08  # ... and climbing: airborne
-    liftoff_lag_s: float = 0.3  # the ramp's last stretch, spent before lift-off was seen
+    liftoff_lag_s: float = 0.2  # the ramp's last stretch, spent before lift-off was felt
+    # No hold below the rangefinder's minimum range plus this margin: a take-off target, or a
+    # hold asked low, goes at least this far above the sonar's blind band, where the estimate
+    # has the sonar again (FlightCore: sonar_min_m + sonar_offset_m + this)
+    blind_margin_m: float = 0.1
     pickup_band_us: int = 25  # the pilot's throttle takes over within this of the held one
     quit_timeout_s: float = 10.0  # a quitting station waits this long for LAND to show
     # Both firmwares' LAND sinks at LAND_SPEED 50 cm/s below 10 m; their land detectors then take

@@ -143,7 +143,11 @@ class Supervisor(StateCommands):
                     self._note(Level.INFO, f"take-off waits up to {self.p.takeoff_wait_s:g} s "
                                "for the arm")
                 self._takeoff_wanted = True
-                self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
+                target, rate = it.setpoint_m, it.rate_mps
+                if target is None:
+                    target = self.takeoff_alt_m
+                    rate = self.takeoff_climb_mps if rate is None else rate
+                self.alt_target_m, self.alt_rate_mps = self.hold_target_m(target), rate
                 return
             self._ended(OutcomeKind.ALT_HOLD_REFUSED, Level.WARNING,
                         f"altitude hold refused: {why}")
@@ -159,11 +163,24 @@ class Supervisor(StateCommands):
                         f"PC flies in {mode_name(self.pc_mode)} (from STABILIZE), the vehicle is "
                         f"in {mode_name(inp.vehicle.mode)}")
             return
-        self.alt_target_m, self.alt_rate_mps = it.setpoint_m, it.rate_mps
+        target, rate = it.setpoint_m, it.rate_mps
+        from_floor = self.state is S.MANUAL and self.on_floor(inp.estimate.alt_m)
+        if from_floor or self.state in (S.SPOOL_UP, S.TAKEOFF):
+            # A hold asked on the floor is a take-off: to the take-off altitude when it names
+            # none (the lift-off height was 0.10 m, in the sonar's blind band), never into the
+            # band. The band's top holds in the air too; a descent (fly's landing) may go lower.
+            if target is None:
+                target = self.takeoff_alt_m
+                rate = self.takeoff_climb_mps if rate is None else rate
+            target = self.hold_target_m(target)
+        elif target is None and self.state is S.MANUAL:
+            target = (self.hold_target_m(inp.estimate.alt_m)
+                      if inp.estimate.alt_m < self.hold_floor_m else None)
+        self.alt_target_m, self.alt_rate_mps = target, rate
         if self.state is S.MANUAL:
-            if self.on_floor(inp.estimate.alt_m):
+            if from_floor:
                 self._go(S.SPOOL_UP if self._t - self._armed_at_s < self.p.spool_s
-                         else S.TAKEOFF, "take-off asked")
+                         else S.TAKEOFF, f"take-off asked, to {target:.2f} m")
             else:
                 self._engage(inp, self.command.throttle_us, "altitude hold on")
 

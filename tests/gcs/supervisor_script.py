@@ -41,6 +41,7 @@ class Script:
         self.down = True  # the vehicle is heard
         self.alt = REST_M
         self.vel = 0.0
+        self.acc = 0.0  # the estimate's bias-corrected upward acceleration
         self.mocap: MocapPose | None = None
         self.sonar = SonarStatus.USED  # what the estimator did with this tick's reading
         self.outs: list[SupervisorOutput] = []
@@ -51,7 +52,7 @@ class Script:
             self.rx_t = self.t
             if self.t - self.hb_t >= 1.0:
                 self.hb_t = self.t
-        est = AltEstimate(self.t, self.alt, self.vel, 0.0, 0.0, True, self.sonar, 0.0, 0.0,
+        est = AltEstimate(self.t, self.alt, self.vel, self.acc, 0.0, True, self.sonar, 0.0, 0.0,
                           False, 0.01, 0)
         v = VehicleStatus(seen=True, armed=self.armed, mode=self.mode, heartbeat_t_s=self.hb_t,
                           frame_age_s=self.t - self.rx_t)
