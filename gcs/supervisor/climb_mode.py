@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from firmware_link.records import FlightMode, RcCommand
 from gcs.control.climb_rate_hold import ClimbRateHold, ClimbRateOutput
+from gcs.supervisor.liftoff import LiftoffDetector
 from gcs.supervisor.outcomes import OutcomeKind
 from gcs.supervisor.params import SupervisorParams
 from gcs.supervisor.types import (
@@ -62,6 +63,10 @@ class ClimbModeCommands:
     alt_rate_mps: float | None
     alt_setpoint_m: float | None
     _alt_mode_seen: bool
+    rest_alt_m: float
+    liftoff_seed: tuple[float, float] | None
+    _liftoff: LiftoffDetector
+    _lifted: bool
 
     def _go(self, state: SupervisorState, reason: str, level: Level = Level.INFO) -> None: ...
     def _note(self, level: Level, text: str) -> None: ...
@@ -108,6 +113,14 @@ class ClimbModeCommands:
         est = inp.estimate
         target = self._climb_target()
         self.alt_setpoint_m = target
+        # The firmware makes the climb, so nothing says what acceleration to expect; what the
+        # accelerometer feels is the lift-off. From then on a reading under the minimum range
+        # is the blind band, not the floor, and the estimate starts over from the climb felt
+        # (pinned to the floor, the first readings past the band failed its gate).
+        if not self._lifted and self._liftoff.update(est.acc_mps2, 0.0, inp.dt_s):
+            self._lifted = True
+            lo = self._liftoff
+            self.liftoff_seed = (self.rest_alt_m + lo.rise_m, lo.vel_mps)
         if est.alt_m >= climb.params.blind_alt_m and est.vel_mps > 0.0:
             self._go(S.HOLD, f"climbed out of the rangefinder's blind band at {est.alt_m:.2f} m: "
                      "altitude hold on (climb rate)")

@@ -61,8 +61,9 @@ class TakeoffCommands:
     def flies_above_blind(self) -> bool:
         """The PC holds a vehicle its take-off felt leave the floor, at or towards a height
         above the sonar's blind band: a reading below the minimum range is the blind band then,
-        not the floor (the estimator's `airborne`). Not while it descends to land."""
-        if self.state is not S.HOLD or not self._lifted:
+        not the floor (the estimator's `airborne`); the climb-rate take-off's climb too, once
+        felt. Not while it descends to land."""
+        if self.state not in (S.HOLD, S.TAKEOFF) or not self._lifted:
             return False
         goal = self.alt_target_m if self.alt_target_m is not None else self.alt_setpoint_m
         return goal is not None and goal >= self.hold_floor_m
