@@ -76,12 +76,13 @@ def test_the_stations_link_loss_landing_fails_the_events(tmp_path: Path) -> None
 
 
 def test_a_hold_straining_at_the_stick_limit_fails_the_control_check(tmp_path: Path) -> None:
-    """A 2.2 kg vehicle hovers at about 71 % throttle (1707 µs); with the station's throttle
-    capped at 1710 µs each correction upward meets the cap."""
+    """A 2.3 kg vehicle hovers a few µs under the station's throttle cap of 1740 µs: each
+    correction upward meets the cap (a 2.2 kg one capped just over its 1707 µs hover met it on
+    only 3-6 % of the ticks once its take-off and hold on the 3.2.1 sonar steps were smooth)."""
     config = tmp_path / "cap.toml"
-    config.write_text("[altitude]\nthrottle_max_us = 1710\n", encoding="utf-8")
+    config.write_text("[altitude]\nthrottle_max_us = 1740\n", encoding="utf-8")
     path, _ = fly_recorded(tmp_path / "strain.mcap", hold_s=HOLD_S, config=config,
-                           world={"vehicle": {"mass_kg": 2.2}})
+                           world={"vehicle": {"mass_kg": 2.3}})
     results = check(path)
     assert results["control.stick_limit_pct"].status is Status.FAIL
-    assert "1710" in results["control.stick_limit_pct"].detail
+    assert "1740" in results["control.stick_limit_pct"].detail

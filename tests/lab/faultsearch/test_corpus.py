@@ -40,10 +40,9 @@ CASES = [
     pytest.param(Case(
         "a fade of both ways in the descent after a step: blind climb, then LAND bounces",
         "apm25", 2089,
-        '[[fault]]\nkind = "fade_both"\nstart = "step+2.212"\nlength = 1.937\n', "overshoot"),
-        marks=_still(reason="#33: found by the fault search; the "
-                                "vehicle climbs blind 0.5 m, then the SITL's LAND hits the "
-                                "floor at 1.6 m/s and rebounds to 2.96 m")),
+        '[[fault]]\nkind = "fade_both"\nstart = "step+2.212"\nlength = 1.937\n', "overshoot")),
+    # was: the vehicle climbed blind 0.5 m, then the SITL's LAND hit the floor at 1.6 m/s and
+    # rebounded to 2.96 m; passes since the take-off and hold work of #32
     pytest.param(Case(
         "a kill while the downlink is faded (the uplink works): disarmed 2.4 s later",
         "apm25", 3,
@@ -56,9 +55,9 @@ CASES = [
         "sonar echoes lost through the take-off: copter4 overshoots the setpoint",
         "copter4", 3,
         '[[fault]]\nkind = "sonar_dropout"\nstart = "takeoff+0.2"\nlength = 4.0\n',
-        "overshoot"),
-        marks=_still(reason="#33: found by the fault search; 0.47 m "
-                                "over a 0.6 m setpoint (bound 0.3 m)")),
+        "overshoot")),
+    # was 0.47 m over a 0.6 m setpoint (bound 0.3 m); passes since the take-off through the
+    # blind band (#32)
 ]
 
 
@@ -72,15 +71,20 @@ def test_a_found_violation_stays_fixed(case: Case) -> None:
         f"{case.name}: {[m for m in run.margins if m.name == case.prop]}")
 
 
+# found schedules the product still violates; the others pass since the take-off through the
+# blind band and the SITL's firmware-side sensor readings (#32), and guard that
+STILL = frozenset({"apm25_impact_seed4539", "apm25_landed_seed1362", "apm25_overshoot_seed4539"})
+
+
 def _found() -> list[Any]:
     cases = []
     for path in sorted(FOUND.glob("*.toml")):
         m = re.fullmatch(r"(apm25|copter4)_(\w+)_seed(\d+)", path.stem)
         assert m is not None, path
         profile, prop, seed = m.group(1), m.group(2), int(m.group(3))
-        cases.append(pytest.param(path, profile, prop, seed, id=path.stem, marks=_still(
-            reason="#33: found by bench/fault_search.py on the product; docs/fault-search.md "
-            "says what was seen")))
+        marks = [_still(reason="#33: found by bench/fault_search.py on the product; "
+                        "docs/fault-search.md says what was seen")] if path.stem in STILL else []
+        cases.append(pytest.param(path, profile, prop, seed, id=path.stem, marks=marks))
     return cases
 
 
