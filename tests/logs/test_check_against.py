@@ -55,9 +55,11 @@ def test_a_flight_with_the_campaigns_own_settings_lies_within_it(
 
 def test_a_flight_with_half_the_kp_is_flagged_beyond_the_campaigns_worst(
         campaign: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """Seed 2 is one where the softer hold shows in how long its errors last (on apm25 it does
-    on 5 of 12 seeds: bench/check_against.py); the settings differ on every one."""
-    code, metrics, differ = _against(capsys, _fly(tmp_path, {"seed": 2, **HALF_KP}), campaign)
+    """Seed 9 (not one of the campaign's) is one where the softer hold shows in how long its
+    errors last: 1.0 s against the campaign's worst 0.275 s (seeds 2-13 measured against this
+    campaign: beyond its worst on 6 of 10, bench/check_against.py flies 60); the settings
+    differ on every one."""
+    code, metrics, differ = _against(capsys, _fly(tmp_path, {"seed": 9, **HALF_KP}), campaign)
     assert code == 1
     assert differ == ["altitude.gains.kp 4.5 (campaign 9.0)"]
     memory = metrics["hold.error_memory_s"]
