@@ -58,6 +58,19 @@ CASES = [
         "overshoot")),
     # was 0.47 m over a 0.6 m setpoint (bound 0.3 m); passes since the take-off through the
     # blind band (#32)
+    pytest.param(Case(
+        "late sonar echoes in the take-off: apm25 overshoots and fly exits 0",
+        "apm25", 1654,
+        '[[fault]]\nkind = "sonar_late"\nstart = "takeoff+5.789"\nlength = 1.681\n'
+        'size = 0.765\n', "overshoot"),
+        marks=_still(reason="#33: found by the known-bug search's space on the product")),
+    pytest.param(Case(
+        "two IMU spikes in the take-off: apm25 overshoots and fly exits 0",
+        "apm25", 5508,
+        '[[fault]]\nkind = "imu_spike"\nstart = "takeoff+5.378"\nlength = 0.097\n'
+        'size = -11.71\n[[fault]]\nkind = "imu_spike"\nstart = "takeoff+3.895"\n'
+        'length = 0.219\nsize = 7.05\n', "overshoot"),
+        marks=_still(reason="#33: found by the known-bug search's space on the product")),
 ]
 
 

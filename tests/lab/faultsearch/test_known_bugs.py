@@ -20,7 +20,21 @@ PLAN = FlightPlan(alt_m=0.6, hold_s=1.0, step_m=0.2, step_observe_s=1.5)
 
 
 # in-process lockstep searches (CPU-bound, not starved by a neighbour): no need to run alone
-@pytest.mark.parametrize("bug", BUGS, ids=[b.prop for b in BUGS])
+def _params() -> list[object]:
+    out: list[object] = []
+    for b in BUGS:
+        marks = []
+        if b.prop == "overshoot":
+            marks.append(pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
+                "#33: since the take-off through the blind band (#32) a reading under the "
+                "minimum range after a felt lift-off is the blind band, so this put-back no "
+                "longer reaches the product's path; the runs its space finds (sonar_late, "
+                "imu_spike in the take-off) overshoot on the product too: regression corpus")))
+        out.append(pytest.param(b, id=b.prop, marks=marks))
+    return out
+
+
+@pytest.mark.parametrize("bug", _params())
 def test_the_search_finds_a_fixed_fault_put_back(bug: KnownBug) -> None:
     flight = SearchFlight(profile=bug.profile, plan=PLAN, fix_failsafe=bug.profile == "copter4")
     space = bug.space
