@@ -18,7 +18,8 @@ from the fault (median, worst, flights later than 20 s; watched 35 s). Exit 1 wh
 flight broke a bound.
 
     .venv/bin/python bench/fault_suite.py [--seeds 1-60] [--profiles apm25,copter4]
-        [--faults up,both,silent] [--rc absent,min] [--config STATION.toml] [--jobs 2]
+        [--faults up,both,silent] [--rc absent,min] [--hold-mode climb-rate|throttle]
+        [--config STATION.toml] [--jobs 2]
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from gcs.commands.fly import fly_session
+from gcs.config import HoldMode, load_config
 from gcs.errors import FlightFailed
 from gcs.flight import FlightPlan
 from gcs.lockstep_session import LockstepSession
@@ -76,6 +78,7 @@ class Case(NamedTuple):
     fault: str
     seed: int
     station_config: str | None
+    hold_mode: str | None
 
 
 class Outcome(NamedTuple):
@@ -98,7 +101,10 @@ def fly_case(case: Case) -> Outcome:
         config=Path(case.station_config) if case.station_config else None)
     direction, length = FAULTS[case.fault]
     faults = {"fade": direction, "fade_start_s": FAULT_AT_S, "fade_s": length}
-    with LockstepSession(options, world=world, faults=faults) as session:
+    config = load_config(options.config)
+    if case.hold_mode is not None:
+        config = dataclasses.replace(config, hold_mode=HoldMode(case.hold_mode))
+    with LockstepSession(options, world=world, faults=faults, config=config) as session:
         pre = session.preflight[1]
         if not pre.ok:
             return Outcome(0.0, None, None, pre.summary())
@@ -172,7 +178,9 @@ def main() -> int:
     ap.add_argument("--profiles", default="apm25,copter4")
     ap.add_argument("--faults", default="up,both,silent")
     ap.add_argument("--rc", default="absent,min", help="receiver: absent, min, mid")
-    ap.add_argument("--config", default=None, help="station TOML (e.g. the hold mode)")
+    ap.add_argument("--config", default=None, help="station TOML")
+    ap.add_argument("--hold-mode", choices=[m.value for m in HoldMode], default=None,
+                    help="the PC hold (default: the station TOML's, else throttle)")
     ap.add_argument("--jobs", type=int, default=2, help="processes (default 2)")
     args = ap.parse_args()
     seeds = seed_range(args.seeds)
@@ -182,10 +190,11 @@ def main() -> int:
         if name not in FAULTS:
             ap.error(f"--faults: {name!r} is not one of {', '.join(FAULTS)}")
     groups = [(p, c, rc, f) for (p, c) in CONFIGS if p in profiles for rc in rcs for f in faults]
-    cases = [Case(p, c, rc, f, s, args.config) for (p, c, rc, f) in groups for s in seeds]
+    cases = [Case(p, c, rc, f, s, args.config, args.hold_mode)
+             for (p, c, rc, f) in groups for s in seeds]
     print(f"lockstep, {SETPOINT_M:g} m hold, fault from t = {FAULT_AT_S:g} s (up/both "
           f"{FADE_S:g} s, silent: for good), seeds {seeds[0]}-{seeds[-1]}, truth heights, "
-          f"station config {args.config or 'default'}")
+          f"station config {args.config or 'default'}, hold mode {args.hold_mode or 'default'}")
     print(f"{'profile':8} {'config':14} {'rc':6} {'fault':6} {'peak m med/max':>15} "
           f"{'>+0.3':>5} {'touch m/s':>11} {'>1':>4} {'up':>5} {'disarm s':>11} {'>20':>4}")
     results: dict[tuple[str, str, str, str], list[Outcome]] = {g: [] for g in groups}
