@@ -65,7 +65,9 @@ def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
 
     In lockstep, so the flight is its seed's: flown at 2x over TCP, the samples counted on the
     move made runs differ, and one in two kept a sample outside 0.85-1.15 m or ran the pack
-    empty before the LAND was seen."""
+    empty before the LAND was seen. Seeds 1-4, 6, 7 reach the battery's LAND; seed 5 (this
+    test's until the take-off through the blind band) now stops earlier, honestly, on 5 counts
+    in a row off the 1 m height at sample 16."""
     world_text, n = re.subn(
         r"(?m)^battery_capacity_mah = .*$",
         "battery_capacity_mah = 300.0\nbattery_resistance_ohm = 0.0225\nmass_kg = 1.88",
@@ -78,7 +80,7 @@ def test_a_battery_failsafe_ends_the_mapping_instead_of_sampling_the_floor(
     mission = tmp_path / "small_pack_mission.toml"
     mission.write_text(text)
     proc = subprocess.run(
-        [sys.executable, "-m", "lab", "mission", "run", str(mission), "--lockstep", "--seed", "5",
+        [sys.executable, "-m", "lab", "mission", "run", str(mission), "--lockstep", "--seed", "3",
          "--json", "-o", str(tmp_path), "--plot", str(tmp_path / "p.png")],
         capture_output=True, text=True, timeout=200, check=False, cwd=ROOT)
     out = proc.stdout.strip().splitlines()
