@@ -120,8 +120,11 @@ def test_grid_results_resume_and_a_failing_run(tmp_path: Path, ray: Any) -> None
     failed = [r for r in rows if r["status"] == "failed"]
     assert len(rows) == 18 and len(failed) == 6
     assert all(r["station.altitude.hover_max"] == 0.3 for r in failed)
-    assert all("no rise at full climb" in r["reason"] and math.isnan(r["rms_error_m"])
-               for r in failed)
+    # (the hold strains at full climb with no rise; or, since the take-off's ramp tops at the
+    # hover it assumes + 100 us, the take-off gives up first)
+    assert all(("no rise at full climb" in r["reason"]
+                or "did not leave the floor" in r["reason"]) and math.isnan(r["rms_error_m"])
+               for r in failed), [r["reason"] for r in failed]
 
 
 @pytest.mark.timeout(240)
