@@ -7,6 +7,7 @@ A part of `StateCommands` (gcs.supervisor.commands), which owns the state declar
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 from firmware_link.records import RcCommand
 from gcs.control.altitude_controller import AltitudeController
@@ -45,17 +46,12 @@ class TakeoffCommands:
     _ramp_top_since_s: float | None
     _t: float
 
-    def _engage(self, inp: TickIn, throttle_us: float, reason: str) -> None:
-        raise NotImplementedError
-
-    def _hold(self, inp: TickIn) -> RcCommand:
-        raise NotImplementedError
-
-    def _went(self, kind: OutcomeKind) -> None:
-        raise NotImplementedError
-
-    def _to_manual(self, reason: str, gate_us: int | None, level: Level = Level.INFO) -> None:
-        raise NotImplementedError
+    if TYPE_CHECKING:  # what StateCommands provides
+        def _engage(self, inp: TickIn, throttle_us: float, reason: str) -> None: ...
+        def _hold(self, inp: TickIn) -> RcCommand: ...
+        def _went(self, kind: OutcomeKind) -> None: ...
+        def _to_manual(self, reason: str, gate_us: int | None,
+                       level: Level = Level.INFO) -> None: ...
 
     @property
     def flies_above_blind(self) -> bool:
