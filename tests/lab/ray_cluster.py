@@ -10,6 +10,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -76,7 +77,7 @@ def kill_processes_of(marker: str, timeout_s: float = 10.0) -> set[int]:
                 killed.add(pid)
             except ProcessLookupError:
                 pass
-        time.sleep(0.1)  # the kernel reaps; this loop ends when none is left
+        threading.Event().wait(0.1)  # the kernel reaps; the loop ends when none is left
     return killed
 
 
