@@ -149,12 +149,13 @@ REPORTED = {
 }
 
 
-# The apm25 cases: the SITL's 3.2.1 rangefinder is the real analog sonar (6 cm steps), on which
-# the station's direct-throttle hold is 7-10 cm RMS (lockstep seeds 1-4: 7.2-9.5 cm), over the
-# 5 cm these flights require before the fault. Not strict: a wall-clock flight may hold better.
-SONAR_STEPS_3_2_1 = ("#32: the station's hold on the SITL's 3.2.1 analog sonar (6 cm steps) is "
-                     "7-10 cm RMS, over the 5 cm required before the fault; a judging of those "
-                     "steps that kept the estimate sound is not built yet")
+# The apm25 cases: the SITL's 3.2.1 rangefinder is the real analog sonar (6 cm steps). The
+# hold before the fault now meets the 5 cm these flights require (lockstep median 2.0 cm, and
+# the lossy and serial cases pass), but the direct-throttle hold is not safe blind on 3.2.1's
+# 5 s GCS timeout (bench/fault_suite.py: up to 3.6 m over the hold). Not strict: wall clock.
+SONAR_STEPS_3_2_1 = ("#32: the direct-throttle hold flies its last override blind for 3.2.1's "
+                     "5 s GCS timeout (bench/fault_suite.py: up to 3.6 m over the hold; the "
+                     "climb-rate hold, not yet the default, stays within 0.32 m)")
 UNSAFE_ON_THE_REAL_FIRMWARE = {
     "downlink-apm25-tcp": SONAR_STEPS_3_2_1,
     "uplink-apm25-tcp": SONAR_STEPS_3_2_1,
